@@ -1,0 +1,43 @@
+// The regular grid of view directions over the outer hemisphere and the compression matrix
+// M_ij = ∫ y_i B_j over the sphere (paper eq. 8-10).
+#pragma once
+
+#include <string>
+
+#include <Eigen/Core>
+#include <glm/glm.hpp>
+
+namespace shrefract {
+
+// nTheta x nPhi samples at cell centres of the (theta, phi) grid over the hemisphere z >= 0 in
+// the local frame (z = normal): theta_i = (i + 1/2) (pi/2) / nTheta, phi_k = (k + 1/2) 2pi / nPhi.
+// Sample index j = i * nPhi + k. nPhi must be even (the pole reflection maps phi to phi + pi).
+struct DirectionGrid {
+    int nTheta = 32, nPhi = 64;
+
+    int count() const { return nTheta * nPhi; }
+    double theta(int i) const;
+    double phi(int k) const;
+    glm::dvec3 direction(int j) const;
+    // The interpolation B_j that extends the samples to the whole sphere: bilinear in
+    // (theta, phi), wrapping in phi, reflected across the pole (theta < theta_0 interpolates
+    // towards the sample at phi + pi), constant past the last ring (the mirror across the
+    // equator), and mirrored to z < 0 (f(x, y, -z) = f(x, y, z)). Writes up to 4 (index, weight)
+    // pairs with weights summing to 1; returns how many.
+    int interpolate(glm::dvec3 w, int index[4], double weight[4]) const;
+    std::string ToString() const;  // "32x64"
+};
+// Parses "32x64"; throws InputError naming `what` on bad text.
+DirectionGrid parseGrid(const std::string& text, const std::string& what = "--grid");
+
+// M (K x J), K = shEvenCount(L) rows in even order, J = grid.count() columns, double precision,
+// by Gauss-Legendre quadrature with `q` x `q` points in every interpolation cell.
+Eigen::MatrixXd compressionMatrix(const DirectionGrid& grid, int L, int q = 8);
+// Least-squares alternative: K x J pseudo-inverse of the basis sampled at the grid directions
+// (weighted by cell solid angle), for the projection-vs-fit comparison.
+Eigen::MatrixXd leastSquaresMatrix(const DirectionGrid& grid, int L);
+// compressionMatrix(), cached on disk in `cacheDir` under a name made of its parameters.
+// A corrupt or mismatched cache file is recomputed and rewritten. Empty cacheDir: no cache.
+Eigen::MatrixXd compressionMatrixCached(const DirectionGrid& grid, int L, const std::string& cacheDir);
+
+}  // namespace shrefract

@@ -1,0 +1,37 @@
+// Triangle meshes from OBJ, OFF, PLY and STL files (OpenMesh), validated.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace shrefract {
+
+struct Mesh {
+    std::vector<glm::vec3> positions;
+    std::vector<glm::vec3> normals;     // per vertex, unit length, outward
+    std::vector<glm::uvec3> triangles;  // counter-clockwise seen from outside
+    bool normalsFromFile = false;
+
+    glm::vec3 boundsMin() const;
+    glm::vec3 boundsMax() const;
+    // A stable FNV-1a checksum of positions and triangles (hex), for the manifest.
+    std::string checksum() const;
+};
+
+// What loading found that is worth telling the user; none of it stops the load.
+struct MeshReport {
+    size_t degenerateTriangles = 0;  // zero-area triangles, skipped
+    size_t borderEdges = 0;          // open mesh: paths may leak
+    size_t nonManifoldEdges = 0;     // edges shared by more than two triangles
+    std::vector<std::string> warnings;  // one line each, already naming the file
+};
+
+// Loads and validates. Polygons are triangulated; vertex normals come from the file when it has
+// them, else are area-weighted face normals. Throws InputError naming the file on: not found,
+// unsupported extension, unparsable, empty (no triangles left), NaN/inf coordinates.
+Mesh loadMesh(const std::string& path, MeshReport* report = nullptr);
+
+}  // namespace shrefract

@@ -4,6 +4,7 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <memory>
@@ -58,7 +59,9 @@ BakeResult bake(const Scene& scene, const BakeOptions& opt, const std::string& i
     std::vector<double> h = shBandFilter(opt.order, opt.filterWidth);
     std::vector<int> band = evenBands(opt.order);
     for (int k = 0; k < K; ++k) Md.row(k) *= h[band[k]];
-    const Eigen::MatrixXf M = Md.cast<float>();
+    // Stored transposed: the GEMM then yields W^T, whose column k (coefficient k of every
+    // sample in the batch, x y z len interleaved) is one contiguous copy into the weights.
+    const Eigen::MatrixXf Mt = Md.transpose().cast<float>();
 
     std::vector<glm::vec3> dirs(J);
     for (int j = 0; j < J; ++j) dirs[j] = glm::vec3(opt.grid.direction(j));
@@ -75,7 +78,7 @@ BakeResult bake(const Scene& scene, const BakeOptions& opt, const std::string& i
 
     tbb::parallel_for(tbb::blocked_range<size_t>(0, batches, 1), [&](const tbb::blocked_range<size_t>& range) {
         enableFlushToZero();
-        Eigen::MatrixXf R(J, 4 * kBatch), W(K, 4 * kBatch);
+        Eigen::MatrixXf R(J, 4 * kBatch), Wt(4 * kBatch, K);
         for (size_t b = range.begin(); b != range.end(); ++b) {
             if (opt.cancel && opt.cancel->load()) return;
             const size_t first = b * kBatch, count = std::min<size_t>(kBatch, n - first);
@@ -102,11 +105,9 @@ BakeResult bake(const Scene& scene, const BakeOptions& opt, const std::string& i
                 }
             }
             auto tGemm = Clock::now();
-            W.noalias() = M * R;  // the projection: one GEMM per batch
-            for (size_t s = 0; s < count; ++s)
-                for (int k = 0; k < K; ++k)
-                    for (int c = 0; c < 4; ++c)
-                        data.weights[(size_t(k) * n + first + s) * 4 + c] = W(k, 4 * s + c);
+            Wt.noalias() = R.transpose() * Mt;  // the projection W = M R: one GEMM per batch
+            for (int k = 0; k < K; ++k)
+                std::copy_n(Wt.col(k).data(), 4 * count, &data.weights[(size_t(k) * n + first) * 4]);
             auto tEnd = Clock::now();
             traceNs += std::chrono::duration_cast<std::chrono::nanoseconds>(tGemm - tTrace).count();
             compressNs += std::chrono::duration_cast<std::chrono::nanoseconds>(tEnd - tGemm).count();

@@ -89,11 +89,12 @@ int main(int argc, char** argv) {
 
     // 3. Compression: the bake's GEMM thread time against a bare GEMM of the same shape.
     const int K = shEvenCount(order), cols = 4 * 32;
-    Eigen::MatrixXf M = Eigen::MatrixXf::Random(K, J), R = Eigen::MatrixXf::Random(J, cols), W(K, cols);
+    // The same shape and operand order as the bake: W^T (cols x K) = R^T (cols x J) M^T (J x K).
+    Eigen::MatrixXf Mt = Eigen::MatrixXf::Random(J, K), R = Eigen::MatrixXf::Random(J, cols), W(cols, K);
     const size_t batches = (L.sampleCount() + 31) / 32;
     t0 = Clock::now();
     for (size_t b = 0; b < batches; ++b) {
-        W.noalias() = M * R;
+        W.noalias() = R.transpose() * Mt;
         R(b % J, 0) += W(0, 0) * 1e-30f;  // keep the optimizer honest
     }
     const double gemmSec = since(t0);

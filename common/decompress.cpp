@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "common/error.h"
 #include "common/frame.h"
 #include "common/sh.h"
 

@@ -39,5 +39,9 @@ Eigen::MatrixXd leastSquaresMatrix(const DirectionGrid& grid, int L);
 // compressionMatrix(), cached on disk in `cacheDir` under a name made of its parameters.
 // A corrupt or mismatched cache file is recomputed and rewritten. Empty cacheDir: no cache.
 Eigen::MatrixXd compressionMatrixCached(const DirectionGrid& grid, int L, const std::string& cacheDir);
+// The same with an explicit quadrature resolution q (the 3-argument form uses q = 8). The file
+// name is shM_L<L>_<grid>_q<q>.bin; its header (magic, L, grid, q, size, checksum) is validated.
+Eigen::MatrixXd compressionMatrixCached(const DirectionGrid& grid, int L, const std::string& cacheDir,
+                                        int q);
 
 }  // namespace shrefract

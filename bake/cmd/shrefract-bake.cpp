@@ -1,0 +1,128 @@
+// shrefract-bake: a glass mesh or scene in, a NAME.shrefract.exr file of SH weights out.
+// A thin shell over bake/ (bake.h); options in docs/bake.md.
+#include <CLI/CLI.hpp>
+
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+
+#include "bake/bake.h"
+#include "bake/layout.h"
+#include "bake/cmd/common_cli.h"
+#include "common/error.h"
+
+using namespace shrefract;
+
+namespace {
+std::atomic<bool> gCancel{false};
+void onSignal(int) { gCancel = true; }
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"shrefract-bake: trace the refracted-path mapping of a glass object with Embree, "
+                 "compress it onto spherical harmonics, write it as OpenEXR."};
+    std::string input, output, grid = "32x64", branch = "fresnel", precision = "f32";
+    BakeOptions opt;
+    double ior = 1.5;
+    int rate = 0;
+    size_t samples = 35000;
+    std::string cache = cli::defaultCacheDir();
+    bool quiet = false;
+    app.add_option("input", input, "mesh (.obj .off .ply .stl) or scene (.json)")->required();
+    app.add_option("-o,--output", output, "output file, NAME.shrefract.exr")->required();
+    app.add_option("--order", opt.order, "SH order L: bands 0..L")->capture_default_str()->check(CLI::Range(0, 20));
+    auto* rateOpt = app.add_option("--rate", rate, "grid steps per triangle edge (overrides --samples)")
+                        ->check(CLI::Range(1, 64));
+    app.add_option("--samples", samples, "target number of unique surface samples")
+        ->capture_default_str()->check(CLI::Range(size_t(1), size_t(50'000'000)))->excludes(rateOpt);
+    app.add_option("--grid", grid, "view directions over the hemisphere, NTHETAxNPHI")->capture_default_str();
+    app.add_option("--ior", ior, "index of refraction for a bare mesh")->capture_default_str()->check(CLI::Range(1.0, 5.0));
+    app.add_option("--branch", branch, "fresnel: larger Fresnel branch; transmit: refract unless TIR")
+        ->capture_default_str()->check(CLI::IsMember({"fresnel", "transmit"}));
+    app.add_option("--max-bounces", opt.trace.maxBounces, "bounce cap per path")->capture_default_str()->check(CLI::Range(1, 10000));
+    app.add_option("--filter", opt.filterWidth, "semi-Gaussian SH low-pass width in bands (0: none)")
+        ->capture_default_str()->check(CLI::Range(0.0, 1000.0));
+    app.add_option("--precision", precision, "weight storage: f32, f16 or u8")->capture_default_str()
+        ->check(CLI::IsMember({"f32", "f16", "u8"}));
+    app.add_option("--threads", opt.threads, "worker threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
+    app.add_option("--cache", cache, "folder for cached compression matrices (empty: none)")->capture_default_str();
+    app.add_flag("-q,--quiet", quiet, "no progress output");
+    CLI11_PARSE(app, argc, argv);
+
+    try {
+        opt.rate = rate;
+        opt.samples = samples;
+        opt.grid = parseGrid(grid, "--grid");
+        opt.trace.branch = branch == "transmit" ? Branch::Transmit : Branch::Fresnel;
+        opt.precision = parsePrecision(precision);
+        opt.cacheDir = cache;
+        namespace fs = std::filesystem;
+        fs::path outDir = fs::absolute(output).parent_path();
+        if (!fs::is_directory(outDir))
+            throw inputError(output, "output folder " + outDir.string() + " does not exist");
+
+        Medium medium;
+        medium.ior = ior;
+        Scene scene = loadScene(input, medium);
+        for (const Part& p : scene.parts)
+            for (const std::string& w : p.report.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+
+        const bool tty = cli::stderrIsTerminal();
+        int lastDecile = -1;
+        if (!quiet) {
+            opt.progress = [&](const BakeProgress& p) {
+                double f = double(p.samplesDone) / std::max<size_t>(1, p.samplesTotal);
+                double rps = p.rays / std::max(1e-9, p.seconds);
+                double eta = f > 0 ? p.seconds * (1 - f) / f : 0;
+                if (tty) {
+                    int filled = static_cast<int>(f * 30);
+                    std::fprintf(stderr, "\r[%-30s] %5.1f%%  %zu/%zu samples  %6.2f Mrays/s  ETA %s ",
+                                 std::string(filled, '#').c_str(), 100 * f, p.samplesDone,
+                                 p.samplesTotal, rps * 1e-6, cli::formatDuration(eta).c_str());
+                } else if (int(f * 10) > lastDecile) {
+                    lastDecile = int(f * 10);
+                    std::fprintf(stderr, "bake: %3.0f%% (%zu/%zu samples, %.2f Mrays/s, ETA %s)\n", 100 * f,
+                                 p.samplesDone, p.samplesTotal, rps * 1e-6, cli::formatDuration(eta).c_str());
+                }
+            };
+        }
+        std::signal(SIGINT, onSignal);
+        std::signal(SIGTERM, onSignal);
+        opt.cancel = &gCancel;
+
+        BakeResult res = bake(scene, opt, input);
+        if (!quiet && tty) std::fprintf(stderr, "\n");
+        if (gCancel) throw Cancelled();
+        writeBake(output, res.data);
+
+        const BakeStats& s = res.stats;
+        auto pct = [&](size_t k) { return 100.0 * double(k) / double(std::max<size_t>(1, s.paths)); };
+        const SurfaceLayout& L = res.data.layout;
+        std::printf("baked %s -> %s\n", input.c_str(), output.c_str());
+        std::printf("  samples     %zu (rate %d, %d triangles), mu %dx%d, rho %dx%d (%.2f texels/sample)\n",
+                    s.samples, L.rate, L.triangleCount, L.muWidth, L.muHeight, L.rhoWidth, L.rhoHeight,
+                    s.rhoOverhead);
+        std::printf("  paths       %zu (%d directions), rays %zu (%.2f per path)\n", s.paths,
+                    opt.grid.count(), s.rays, double(s.rays) / std::max<size_t>(1, s.paths));
+        std::printf("  time        %.1f s wall (trace %.1f s, compress %.1f s thread time), %.2f Mrays/s\n",
+                    s.wallSeconds, s.traceSeconds, s.compressSeconds, s.rays / s.wallSeconds * 1e-6);
+        std::printf("  paths with  TIR %.2f%%, capped %.3f%% (soft %.3f%%), left and re-entered %.2f%%, "
+                    "geometric-normal fallback %.3f%%, leaked %.3f%%\n",
+                    pct(s.tir), pct(s.capped), pct(s.softCapped), pct(s.reentered), pct(s.geometricNormal),
+                    pct(s.leaked));
+        std::printf("  file        %.1f MB, order %d, %d coefficients, %s\n",
+                    std::filesystem::file_size(output) / 1e6, opt.order, res.data.coefficientCount(),
+                    precision.c_str());
+        return 0;
+    } catch (const Cancelled&) {
+        std::fprintf(stderr, "\nshrefract-bake: cancelled; no file written\n");
+        return 130;
+    } catch (const InputError& e) {
+        std::fprintf(stderr, "shrefract-bake: error: %s\n", e.what());
+        return 2;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "shrefract-bake: error: %s\n", e.what());
+        return 1;
+    }
+}

@@ -1,0 +1,181 @@
+#include "bake/eval.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <numeric>
+#include <random>
+
+#include "bake/tracer.h"
+#include "common/decompress.h"
+#include "common/error.h"
+#include "common/frame.h"
+
+namespace shrefract {
+
+Scene sceneOfBake(const BakeData& bake, const std::string& bakePath, const std::string& overridePath) {
+    const nlohmann::json& m = bake.manifest;
+    std::string input = overridePath.empty() ? m.value("input", std::string()) : overridePath;
+    if (input.empty()) throw inputError(bakePath, "manifest names no input scene; pass --scene");
+    if (!std::filesystem::exists(input))
+        throw inputError(bakePath, "its input scene " + input + " is not there; pass --scene");
+    Medium medium;
+    if (m.contains("media") && !m["media"].empty()) {
+        const auto& md = m["media"][0];
+        medium.ior = md.value("ior", 1.5);
+        medium.priority = md.value("priority", 0);
+    }
+    Scene scene = loadScene(input, medium);
+    if (m.contains("media") && m["media"].size() == scene.parts.size()) {
+        for (size_t i = 0; i < scene.parts.size(); ++i) {
+            std::string want = m["media"][i].value("meshChecksum", std::string());
+            if (!want.empty() && want != scene.parts[i].mesh.checksum())
+                throw inputError(input, "mesh differs from the one baked into " + bakePath +
+                                            " (checksum " + scene.parts[i].mesh.checksum() + ", baked " + want + ")");
+        }
+    }
+    return scene;
+}
+
+nlohmann::json errorStats(std::vector<double> e) {
+    if (e.empty()) return {{"count", 0}};
+    std::sort(e.begin(), e.end());
+    auto pct = [&](double q) { return e[std::min(e.size() - 1, static_cast<size_t>(q * (e.size() - 1) + 0.5))]; };
+    double mean = std::accumulate(e.begin(), e.end(), 0.0) / e.size();
+    return {{"count", e.size()}, {"mean", mean}, {"median", pct(0.5)}, {"p95", pct(0.95)},
+            {"p99", pct(0.99)}, {"max", e.back()}};
+}
+
+nlohmann::json evaluateDirections(const BakeData& bake, const Scene& scene, size_t pairs,
+                                  uint64_t seed, int order) {
+    const SurfaceLayout& L = bake.layout;
+    TraceOptions topt;
+    const auto& m = bake.manifest;
+    topt.branch = m.value("branch", std::string("fresnel")) == "transmit" ? Branch::Transmit : Branch::Fresnel;
+    topt.maxBounces = m.value("maxBounces", 32);
+    Tracer tracer(scene, topt);
+
+    struct Pair {
+        uint32_t sample;
+        glm::vec3 omegaLocal;
+    };
+    // Draw all pairs up front from one generator so results do not depend on thread count.
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<float> U(0.0f, 1.0f);
+    std::uniform_int_distribution<uint32_t> S(0, static_cast<uint32_t>(L.sampleCount() - 1));
+    std::vector<Pair> draws(pairs);
+    for (Pair& p : draws) {
+        p.sample = S(rng);
+        // Uniform over the hemisphere: z = cos(theta) uniform in [0, 1).
+        float z = U(rng), phi = 6.28318530718f * U(rng), sxy = std::sqrt(std::max(0.0f, 1 - z * z));
+        p.omegaLocal = glm::vec3(sxy * std::cos(phi), sxy * std::sin(phi), z);
+    }
+    std::vector<double> angle(pairs), lenErr(pairs);
+    std::vector<uint32_t> flags(pairs);
+    tbb::parallel_for(size_t(0), pairs, [&](size_t k) {
+        enableFlushToZero();
+        const Pair& p = draws[k];
+        const Frame f = Frame::fromNormal(L.normal[p.sample]);
+        PathResult truth = tracer.trace(L.position[p.sample], L.normal[p.sample], f.fromLocal(p.omegaLocal),
+                                        L.part[p.sample]);
+        glm::vec4 d = decompressSample(bake, static_cast<int>(p.sample), p.omegaLocal, order);
+        glm::vec3 e(d);
+        float len = glm::length(e);
+        double cosA = len > 0 ? glm::dot(e / len, truth.exit) : -1.0;
+        angle[k] = std::acos(std::clamp(cosA, -1.0, 1.0)) * 180.0 / M_PI;
+        lenErr[k] = std::abs(double(d.w) - truth.length);
+        flags[k] = truth.flags;
+    });
+    auto subset = [&](uint32_t mask, bool none) {
+        std::vector<double> a, l;
+        for (size_t k = 0; k < pairs; ++k) {
+            bool in = none ? (flags[k] & (kPathTIR | kPathCapped | kPathReentered)) == 0 : (flags[k] & mask) != 0;
+            if (in) a.push_back(angle[k]), l.push_back(lenErr[k]);
+        }
+        return nlohmann::json{{"share", double(a.size()) / std::max<size_t>(1, pairs)},
+                              {"angleDeg", errorStats(a)},
+                              {"lengthError", errorStats(l)}};
+    };
+    return {{"pairs", pairs},
+            {"seed", seed},
+            {"order", order < 0 ? bake.order : std::min(order, bake.order)},
+            {"angleDeg", errorStats(angle)},
+            {"lengthError", errorStats(lenErr)},
+            {"tir", subset(kPathTIR, false)},
+            {"capped", subset(kPathCapped, false)},
+            {"reentered", subset(kPathReentered, false)},
+            {"plain", subset(0, true)}};
+}
+
+namespace {
+
+// Closest point to p on triangle (a, b, c), as barycentric weights (u, v) of b and c.
+glm::vec2 closestBarycentric(glm::vec3 p, glm::vec3 a, glm::vec3 b, glm::vec3 c, float* dist2) {
+    glm::vec3 e1 = b - a, e2 = c - a, ap = p - a;
+    float d11 = glm::dot(e1, e1), d12 = glm::dot(e1, e2), d22 = glm::dot(e2, e2);
+    float p1 = glm::dot(ap, e1), p2 = glm::dot(ap, e2);
+    float det = d11 * d22 - d12 * d12;
+    glm::vec2 best(0.0f);
+    float bestD = std::numeric_limits<float>::max();
+    auto consider = [&](float u, float v) {
+        glm::vec3 q = a + u * e1 + v * e2;
+        float d = glm::dot(p - q, p - q);
+        if (d < bestD) bestD = d, best = {u, v};
+    };
+    if (det > 0) {
+        float u = (d22 * p1 - d12 * p2) / det, v = (d11 * p2 - d12 * p1) / det;
+        if (u >= 0 && v >= 0 && u + v <= 1) consider(u, v);
+    }
+    if (bestD == std::numeric_limits<float>::max()) {
+        // Outside: the closest point is on an edge.
+        auto seg = [&](glm::vec3 s0, glm::vec3 s1, auto toUV) {
+            glm::vec3 s = s1 - s0;
+            float t = std::clamp(glm::dot(p - s0, s) / std::max(glm::dot(s, s), 1e-30f), 0.0f, 1.0f);
+            glm::vec2 uv = toUV(t);
+            consider(uv.x, uv.y);
+        };
+        seg(a, b, [](float t) { return glm::vec2(t, 0); });
+        seg(a, c, [](float t) { return glm::vec2(0, t); });
+        seg(b, c, [](float t) { return glm::vec2(1 - t, t); });
+    }
+    *dist2 = bestD;
+    return best;
+}
+
+}  // namespace
+
+std::vector<glm::vec4> queryBake(const BakeData& bake, const std::vector<glm::vec3>& p,
+                                 const std::vector<glm::vec3>& w) {
+    const SurfaceLayout& L = bake.layout;
+    const int r = L.rate;
+    std::vector<glm::vec4> values(L.sampleCount(), glm::vec4(0.0f));
+    std::vector<glm::vec4> out(p.size());
+    for (size_t q = 0; q < p.size(); ++q) {
+        int bestT = 0;
+        glm::vec2 bestUV(0.0f);
+        float bestD = std::numeric_limits<float>::max();
+        for (int t = 0; t < L.triangleCount; ++t) {
+            glm::vec3 a = L.position[L.sampleAt(t, 0, 0)], b = L.position[L.sampleAt(t, r, 0)],
+                      c = L.position[L.sampleAt(t, 0, r)];
+            float d2;
+            glm::vec2 uv = closestBarycentric(p[q], a, b, c, &d2);
+            if (d2 < bestD) bestD = d2, bestT = t, bestUV = uv;
+        }
+        const glm::vec3 omega = glm::normalize(w[q]);
+        for (int j = 0; j <= r; ++j)
+            for (int i = 0; i + j <= r; ++i) {
+                uint32_t s = L.sampleAt(bestT, i, j);
+                values[s] = decompressSample(bake, static_cast<int>(s), localViewDirection(L, s, omega));
+            }
+        glm::vec4 d = interpolateRho(L, values.data(), bestT, bestUV.x, bestUV.y);
+        glm::vec3 e(d);
+        float len = glm::length(e);
+        out[q] = glm::vec4(len > 0 ? e / len : e, d.w);
+    }
+    return out;
+}
+
+}  // namespace shrefract

@@ -1,0 +1,37 @@
+// Checking a bake against fresh traces, and answering point queries as the runtime would.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+#include "common/bakefile.h"
+#include "common/scene.h"
+
+namespace shrefract {
+
+// The scene a bake was made from: its manifest's input path (or `overridePath` if not empty),
+// loaded with the baked medium. Throws InputError if it is missing or its mesh checksum
+// differs from the one baked.
+Scene sceneOfBake(const BakeData& bake, const std::string& bakePath, const std::string& overridePath = "");
+
+// Random (sample, omega) pairs, omega uniform over the outer hemisphere (so almost surely
+// between grid directions), decompressed against a fresh trace of the same path. Angular error
+// in degrees: mean, median, p95, p99, max; path-length error; the shares of TIR, capped and
+// re-entering paths, each with its own error. `order` < 0: all stored bands.
+nlohmann::json evaluateDirections(const BakeData& bake, const Scene& scene, size_t pairs,
+                                  uint64_t seed, int order = -1);
+
+// For each object-space surface point p and unit view direction w (toward the viewer): the
+// exit direction (normalized) and length the runtime would use there, interpolated across the
+// nearest triangle exactly as the rho layout does (interpolateRho). Viewer at infinity along w.
+std::vector<glm::vec4> queryBake(const BakeData& bake, const std::vector<glm::vec3>& p,
+                                 const std::vector<glm::vec3>& w);
+
+// Summary statistics of a list of errors: mean, median, p95, p99, max, count.
+nlohmann::json errorStats(std::vector<double> e);
+
+}  // namespace shrefract

@@ -1,0 +1,247 @@
+#include "bake/tracer.h"
+
+#include <embree3/rtcore.h>
+#include <pmmintrin.h>
+#include <xmmintrin.h>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "common/optics.h"
+
+namespace shrefract {
+
+void enableFlushToZero() {
+    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+}
+
+struct Tracer::Embree {
+    RTCDevice device = nullptr;
+    RTCScene scene = nullptr;
+    ~Embree() {
+        if (scene) rtcReleaseScene(scene);
+        if (device) rtcReleaseDevice(device);
+    }
+};
+
+namespace {
+
+void embreeError(void*, RTCError code, const char* str) {
+    std::fprintf(stderr, "shrefract: Embree error %d: %s\n", int(code), str ? str : "");
+}
+
+// The media a ray is inside, by part index. Nested dielectrics: the medium in effect is the one
+// of highest priority (ties: the most recently entered), as in production renderers.
+struct MediaStack {
+    static constexpr int kMax = 16;
+    uint32_t part[kMax];
+    int n = 0;
+
+    bool contains(uint32_t p) const {
+        for (int i = 0; i < n; ++i)
+            if (part[i] == p) return true;
+        return false;
+    }
+    void add(uint32_t p) {
+        if (!contains(p) && n < kMax) part[n++] = p;
+    }
+    void remove(uint32_t p) {
+        for (int i = 0; i < n; ++i)
+            if (part[i] == p) {
+                for (int k = i; k + 1 < n; ++k) part[k] = part[k + 1];
+                --n;
+                return;
+            }
+    }
+    // Index of the part in effect, or -1 for air.
+    int top(const Scene& s) const {
+        int best = -1;
+        for (int i = 0; i < n; ++i)
+            if (best < 0 || s.parts[part[i]].medium.priority >= s.parts[best].medium.priority)
+                best = static_cast<int>(part[i]);
+        return best;
+    }
+};
+
+float iorOf(const Scene& s, int part) { return part < 0 ? 1.0f : float(s.parts[part].medium.ior); }
+
+}  // namespace
+
+Tracer::Tracer(const Scene& scene, TraceOptions options)
+    : scene_(scene), options_(options), rtc_(std::make_unique<Embree>()) {
+    rtc_->device = rtcNewDevice(nullptr);
+    if (!rtc_->device) throw std::runtime_error("Embree: rtcNewDevice failed");
+    rtcSetDeviceErrorFunction(rtc_->device, embreeError, nullptr);
+    rtc_->scene = rtcNewScene(rtc_->device);
+    rtcSetSceneBuildQuality(rtc_->scene, RTC_BUILD_QUALITY_HIGH);
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (const Part& p : scene.parts) {
+        RTCGeometry g = rtcNewGeometry(rtc_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        // Embree reads 16 bytes at the last vertex: its buffers are padded by one float.
+        float* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+            g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), p.mesh.positions.size() + 1));
+        for (size_t i = 0; i < p.mesh.positions.size(); ++i) {
+            glm::vec3 x = p.mesh.positions[i];
+            v[3 * i] = x.x, v[3 * i + 1] = x.y, v[3 * i + 2] = x.z;
+            lo = glm::min(lo, x), hi = glm::max(hi, x);
+        }
+        unsigned* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+            g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), p.mesh.triangles.size()));
+        for (size_t t = 0; t < p.mesh.triangles.size(); ++t)
+            for (int k = 0; k < 3; ++k) idx[3 * t + k] = p.mesh.triangles[t][k];
+        rtcCommitGeometry(g);
+        rtcAttachGeometry(rtc_->scene, g);  // ids 0, 1, ... = part index
+        rtcReleaseGeometry(g);
+    }
+    rtcCommitScene(rtc_->scene);
+    // Offsets scale with the scene: float spacing at the largest coordinate is ~6e-8 of it, so
+    // 1e-5 of the extent clears self-intersection yet stays far below any feature we sample.
+    float extent = std::max(glm::length(hi - lo), std::max(glm::length(hi), glm::length(lo)));
+    epsilon_ = 1e-5f * std::max(extent, 1e-20f);
+}
+
+Tracer::~Tracer() = default;
+
+bool Tracer::intersect(glm::vec3 org, glm::vec3 dir, float* t) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh;
+    rh.ray.org_x = org.x, rh.ray.org_y = org.y, rh.ray.org_z = org.z;
+    rh.ray.dir_x = dir.x, rh.ray.dir_y = dir.y, rh.ray.dir_z = dir.z;
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = std::numeric_limits<float>::infinity();
+    rh.ray.mask = 0xFFFFFFFF;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(rtc_->scene, &ctx, &rh);
+    *t = rh.ray.tfar;
+    return rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+}
+
+PathResult Tracer::trace(glm::vec3 p, glm::vec3 n, glm::vec3 omega, uint32_t part,
+                         std::vector<LoggedRay>* log) const {
+    PathResult res;
+    const Scene& s = scene_;
+    const float eps = epsilon_;
+    const int cap = options_.maxBounces;
+
+    // Rule 1: the first interface transmits (the primary reflection is the runtime's).
+    MediaStack media;
+    media.add(part);
+    glm::vec3 d;
+    if (!Refract(omega, n, iorOf(s, media.top(s)) / 1.0f, &d)) {
+        // Only an "optically thinner than air" medium can do this; it reflects, and leaves.
+        res.exit = Reflect(omega, n);
+        res.flags |= kPathTIR;
+        return res;
+    }
+    glm::vec3 org = p - n * eps;
+
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    for (;;) {
+        RTCRayHit rh;
+        rh.ray.org_x = org.x, rh.ray.org_y = org.y, rh.ray.org_z = org.z;
+        rh.ray.dir_x = d.x, rh.ray.dir_y = d.y, rh.ray.dir_z = d.z;
+        rh.ray.tnear = 0.0f;
+        rh.ray.tfar = std::numeric_limits<float>::infinity();
+        rh.ray.mask = 0xFFFFFFFF;
+        rh.ray.flags = 0;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(rtc_->scene, &ctx, &rh);
+        if (log) log->push_back({org, d});
+        ++res.rays;
+
+        const int before = media.top(s);
+        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+            // Rule 4: the direction that finally escapes to infinity.
+            if (media.n > 0) res.flags |= kPathLeaked;
+            res.exit = d;
+            return res;
+        }
+        // Rule 6: length inside non-air media.
+        if (before >= 0) res.length += rh.ray.tfar;
+
+        const uint32_t q = rh.hit.geomID;
+        const Mesh& m = s.parts[q].mesh;
+        const glm::uvec3 tri = m.triangles[rh.hit.primID];
+        const float u = rh.hit.u, v = rh.hit.v, w = 1.0f - u - v;
+        const glm::vec3 hitP = w * m.positions[tri[0]] + u * m.positions[tri[1]] + v * m.positions[tri[2]];
+        glm::vec3 ng = glm::normalize(glm::cross(m.positions[tri[1]] - m.positions[tri[0]],
+                                                 m.positions[tri[2]] - m.positions[tri[0]]));
+        glm::vec3 ns = w * m.normals[tri[0]] + u * m.normals[tri[1]] + v * m.normals[tri[2]];
+        float nsLen = glm::length(ns);
+        ns = nsLen > 0 ? ns / nsLen : ng;
+
+        const bool entering = glm::dot(d, ng) < 0.0f;
+        if (entering && media.n == 0) res.flags |= kPathReentered;  // it had left: rule 4
+        MediaStack next = media;
+        if (entering) next.add(q); else next.remove(q);
+        const int after = next.top(s);
+
+        if (after == before) {
+            // A boundary inside a medium of higher priority: not an interface, go straight on.
+            media = next;
+            org = hitP + d * eps;
+            continue;
+        }
+        // Normals facing the side the ray comes from.
+        const glm::vec3 ngf = entering ? ng : -ng;
+        glm::vec3 nf = entering ? ns : -ns;
+        const glm::vec3 wi = -d;
+        // Rule 3: a shading normal that faces away from the incoming ray cannot be used.
+        if (glm::dot(nf, wi) <= 0.0f) {
+            nf = ngf;
+            res.flags |= kPathGeometricNormal;
+        }
+        const float eta = iorOf(s, after) / iorOf(s, before);
+        glm::vec3 wt;
+        bool canTransmit = Refract(wi, nf, eta, &wt);
+        if (canTransmit && glm::dot(wt, ngf) >= 0.0f) {
+            // Rule 3: refracted onto the wrong side of the true surface: redo about Ng.
+            res.flags |= kPathGeometricNormal;
+            nf = ngf;
+            canTransmit = Refract(wi, nf, eta, &wt);
+        }
+        bool reflect;
+        if (!canTransmit) {
+            reflect = true;  // Rule 2: total internal reflection
+            res.flags |= kPathTIR;
+        } else if (options_.branch == Branch::Transmit) {
+            reflect = false;
+        } else if (res.bounces >= cap / 2) {
+            // Rule 5: past half the cap, take the transmitted branch whenever it exists, so
+            // every path ends deterministically.
+            reflect = false;
+            if (FresnelDielectric(glm::dot(wi, nf), eta) > 0.5f) res.flags |= kPathSoftCapped;
+        } else {
+            reflect = FresnelDielectric(glm::dot(wi, nf), eta) > 0.5f;  // the larger branch
+        }
+        if (reflect) {
+            d = Reflect(wi, nf);
+            if (glm::dot(d, ngf) <= 0.0f) {
+                res.flags |= kPathGeometricNormal;
+                d = Reflect(wi, ngf);
+            }
+            org = hitP + ngf * eps;
+        } else {
+            d = wt;
+            media = next;
+            org = hitP - ngf * eps;
+        }
+        d = glm::normalize(d);
+        ++res.bounces;
+        if (res.bounces >= cap) {
+            // Rule 5: the hard cap. The path ends here, along its current direction.
+            res.flags |= kPathCapped;
+            res.exit = d;
+            return res;
+        }
+    }
+}
+
+}  // namespace shrefract

@@ -1,0 +1,76 @@
+// The Embree tracer of refracted paths (DESIGN.md §3 "Path rules", docs/bake.md).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "common/scene.h"
+
+namespace shrefract {
+
+enum class Branch { Fresnel, Transmit };
+
+struct TraceOptions {
+    Branch branch = Branch::Fresnel;  // the larger Fresnel branch, or refract unless TIR
+    int maxBounces = 32;              // hard cap; past half of it the transmitted branch wins
+};
+
+// What happened along one path; flags are OR-ed over its events.
+enum PathFlags : uint32_t {
+    kPathTIR = 1,               // total internal reflection at least once
+    kPathCapped = 2,            // reached maxBounces: ended deterministically
+    kPathReentered = 4,         // left the object and hit it again (ears, handles, knots)
+    kPathGeometricNormal = 8,   // the shading normal put a ray on the wrong side: Ng used
+    kPathLeaked = 16,           // escaped while still inside a medium (open mesh)
+    kPathSoftCapped = 32,       // passed half the cap and was forced to transmit
+};
+
+struct PathResult {
+    glm::vec3 exit{0.0f};  // direction that finally escapes, object space, unit
+    float length = 0.0f;   // distance travelled inside non-air media
+    uint32_t flags = 0;
+    uint16_t bounces = 0;  // interfaces that deflected the ray after the first
+    uint16_t rays = 0;     // Embree queries
+};
+
+// A ray as the tracer shot it, for the bare-Embree ceiling in the benchmark.
+struct LoggedRay {
+    glm::vec3 org, dir;
+};
+
+class Tracer {
+public:
+    // Builds one Embree scene over all parts. Throws std::runtime_error on Embree errors.
+    Tracer(const Scene& scene, TraceOptions options = {});
+    ~Tracer();
+    Tracer(const Tracer&) = delete;
+    Tracer& operator=(const Tracer&) = delete;
+
+    // The path entering part `part` at surface point `p` with outward shading normal `n`, along
+    // the object-space direction `-omega` (omega points toward the viewer, n . omega > 0).
+    // Rule 1: the first interface always transmits.
+    PathResult trace(glm::vec3 p, glm::vec3 n, glm::vec3 omega, uint32_t part,
+                     std::vector<LoggedRay>* log = nullptr) const;
+
+    // A bare closest-hit query, nothing else: the ceiling the benchmark compares against.
+    bool intersect(glm::vec3 org, glm::vec3 dir, float* t) const;
+
+    // Ray offsets scale with the scene: this times its bounding-box extent.
+    float epsilon() const { return epsilon_; }
+    const Scene& scene() const { return scene_; }
+
+private:
+    struct Embree;
+    const Scene& scene_;
+    TraceOptions options_;
+    std::unique_ptr<Embree> rtc_;
+    float epsilon_ = 1e-5f;
+};
+
+// Sets flush-to-zero and denormals-are-zero on the calling thread (every tracing thread).
+void enableFlushToZero();
+
+}  // namespace shrefract

@@ -1,4 +1,5 @@
 // Lat-long EXR -> GL cube map, and the background pass.
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 

@@ -140,6 +140,8 @@ PathResult Tracer::trace(glm::vec3 p, glm::vec3 n, glm::vec3 omega, uint32_t par
         return res;
     }
     glm::vec3 org = p - n * eps;
+    glm::vec3 from = p;  // the surface point this segment started at: lengths are measured
+                         // between true surface points, not from offset origins
 
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
@@ -163,9 +165,6 @@ PathResult Tracer::trace(glm::vec3 p, glm::vec3 n, glm::vec3 omega, uint32_t par
             res.exit = d;
             return res;
         }
-        // Rule 6: length inside non-air media.
-        if (before >= 0) res.length += rh.ray.tfar;
-
         const uint32_t q = rh.hit.geomID;
         const Mesh& m = s.parts[q].mesh;
         const glm::uvec3 tri = m.triangles[rh.hit.primID];
@@ -176,6 +175,9 @@ PathResult Tracer::trace(glm::vec3 p, glm::vec3 n, glm::vec3 omega, uint32_t par
         glm::vec3 ns = w * m.normals[tri[0]] + u * m.normals[tri[1]] + v * m.normals[tri[2]];
         float nsLen = glm::length(ns);
         ns = nsLen > 0 ? ns / nsLen : ng;
+        // Rule 6: length inside non-air media.
+        if (before >= 0) res.length += glm::length(hitP - from);
+        from = hitP;
 
         const bool entering = glm::dot(d, ng) < 0.0f;
         if (entering && media.n == 0) res.flags |= kPathReentered;  // it had left: rule 4

@@ -12,19 +12,19 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Run {
+struct CommandResult {
     int code;
     std::string out;  // stdout and stderr together
 };
 
-Run run(const std::string& args) {
+CommandResult run(const std::string& args) {
     fs::create_directories(SHREFRACT_TEST_TMP);
     std::string log = std::string(SHREFRACT_TEST_TMP) + "/cli_log.txt";
     int status = std::system((args + " > " + log + " 2>&1").c_str());
     std::ifstream f(log);
     std::stringstream ss;
     ss << f.rdbuf();
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
+    return CommandResult{WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
 }
 
 std::string tmp(const std::string& name) { return std::string(SHREFRACT_TEST_TMP) + "/" + name; }
@@ -36,7 +36,7 @@ void write(const std::string& path, const std::string& text) {
 
 const std::string kBake = SHREFRACT_BAKE_EXE;
 const std::string kEval = SHREFRACT_EVAL_EXE;
-const std::string kTetra = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+constexpr const char* kTetra = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
 
 // Each case: an input file's content (or none), extra arguments, and a word the message needs.
 struct BadCase {
@@ -55,7 +55,7 @@ TEST_P(BakeRejects, WithAClearErrorAndNoOutput) {
     if (c.content) write(in, c.content);
     std::string out = tmp(std::string("bad_") + c.name + ".shrefract.exr");
     fs::remove(out);
-    Run r = run(kBake + " " + in + " -o " + out + " --cache '' -q " + c.args);
+    CommandResult r = run(kBake + " " + in + " -o " + out + " --cache '' -q " + c.args);
     EXPECT_NE(r.code, 0) << r.out;
     EXPECT_NE(r.out.find(c.expect), std::string::npos) << "message: " << r.out;
     EXPECT_FALSE(fs::exists(out));
@@ -82,7 +82,7 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST(BakeCli, MissingOutputFolderIsAnErrorBeforeAnyWork) {
     write(tmp("tetra.off"), kTetra);
-    Run r = run(kBake + " " + tmp("tetra.off") + " -o " + tmp("no/such/dir/x.shrefract.exr") + " -q");
+    CommandResult r = run(kBake + " " + tmp("tetra.off") + " -o " + tmp("no/such/dir/x.shrefract.exr") + " -q");
     EXPECT_NE(r.code, 0);
     EXPECT_NE(r.out.find("does not exist"), std::string::npos) << r.out;
 }
@@ -90,7 +90,7 @@ TEST(BakeCli, MissingOutputFolderIsAnErrorBeforeAnyWork) {
 TEST(BakeCli, BadInputKeepsAnExistingOutputFile) {
     std::string out = tmp("keep.shrefract.exr");
     write(out, "precious");
-    Run r = run(kBake + " " + tmp("nope.off") + " -o " + out + " -q");
+    CommandResult r = run(kBake + " " + tmp("nope.off") + " -o " + out + " -q");
     EXPECT_NE(r.code, 0);
     std::ifstream f(out);
     std::string s;
@@ -104,17 +104,17 @@ TEST(BakeCli, BakesAndEvaluatesATetrahedron) {
     write(tmp("tetra.off"), kTetra);
     std::string out = tmp("tetra.shrefract.exr");
     fs::remove(out);
-    Run b = run(kBake + " " + tmp("tetra.off") + " -o " + out + " --rate 2 --grid 8x16 --order 4 --cache ''");
+    CommandResult b = run(kBake + " " + tmp("tetra.off") + " -o " + out + " --rate 2 --grid 8x16 --order 4 --cache ''");
     ASSERT_EQ(b.code, 0) << b.out;
     EXPECT_NE(b.out.find("samples"), std::string::npos);
     EXPECT_TRUE(fs::exists(out));
-    Run e = run(kEval + " directions " + out + " --pairs 2000 --json " + tmp("tetra.json"));
+    CommandResult e = run(kEval + " directions " + out + " --pairs 2000 --json " + tmp("tetra.json"));
     ASSERT_EQ(e.code, 0) << e.out;
     EXPECT_NE(e.out.find("median"), std::string::npos);
     EXPECT_TRUE(fs::exists(tmp("tetra.json")));
 
     write(tmp("q.csv"), "px,py,pz,wx,wy,wz\n0.2,0.2,0,0,0,-1\n0.1,0,0.1,0,-1,0\n");
-    Run q = run(kEval + " query " + out + " --in " + tmp("q.csv") + " --out " + tmp("a.csv"));
+    CommandResult q = run(kEval + " query " + out + " --in " + tmp("q.csv") + " --out " + tmp("a.csv"));
     ASSERT_EQ(q.code, 0) << q.out;
     std::ifstream a(tmp("a.csv"));
     std::string header, line;
@@ -125,7 +125,7 @@ TEST(BakeCli, BakesAndEvaluatesATetrahedron) {
     EXPECT_EQ(rows, 2);
 
     write(tmp("bad.csv"), "1,2,3\n");
-    Run qb = run(kEval + " query " + out + " --in " + tmp("bad.csv") + " --out " + tmp("b.csv"));
+    CommandResult qb = run(kEval + " query " + out + " --in " + tmp("bad.csv") + " --out " + tmp("b.csv"));
     EXPECT_NE(qb.code, 0);
     EXPECT_NE(qb.out.find("bad.csv"), std::string::npos) << qb.out;
     EXPECT_FALSE(fs::exists(tmp("b.csv")));

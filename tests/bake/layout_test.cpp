@@ -129,7 +129,8 @@ TEST_P(LayoutAtRate, CorrectionMakesBilinearFilteringBarycentric) {
             if (r == 1) EXPECT_LT(glm::length(bilinear(img, L.rhoWidth, L.rhoHeight, xy) - expect), 1e-5f);
         }
     }
-    EXPECT_LT(worstOn, 1e-5f);   // float rounding only
+    // Float rounding only: measured 1.5e-5 at rate 5, where texel coordinates reach ~1e2.
+    EXPECT_LT(worstOn, 5e-5f);
     EXPECT_GT(worstOff, 1e-2f);  // without correction the half-cells are wrong
 }
 

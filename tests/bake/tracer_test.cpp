@@ -36,7 +36,9 @@ TEST(Tracer, ParallelSlabExitsAlongEntryWithKnownLength) {
         float sinT = std::sin(theta * kPi / 180) / 1.5f;
         float expectedLength = 1.0f / std::sqrt(1 - sinT * sinT);
         EXPECT_NEAR(glm::dot(r.exit, -omega), 1.0f, 1e-6f) << "theta " << theta << " exit " << str(r.exit);
-        EXPECT_NEAR(r.length, expectedLength, 1e-5f) << "theta " << theta;
+        // The ray starts eps = 1e-5 x extent (5.7e-5 here) inside along the normal, which
+        // shifts its hit sideways: measured up to 1.7e-5 at 50 degrees.
+        EXPECT_NEAR(r.length, expectedLength, 4e-5f) << "theta " << theta;
         EXPECT_EQ(r.flags, 0u);
         EXPECT_EQ(r.rays, 2);
         EXPECT_EQ(r.bounces, 1);
@@ -130,24 +132,24 @@ TEST(Tracer, PrismTotalInternalReflection) {
 // are horizontal, so the path leaves along its entry direction, and its length tells which
 // medium owned each stretch.
 TEST(Tracer, NestedMediaResolvedByPriority) {
-    Mesh glass = flatBox({-1, -1, -1}, {1, 1, 1});
-    test::append(glass, flatBox({-0.8f, -0.8f, -0.8f}, {0.8f, 0.8f, 0.8f}, /*inward=*/true));
+    Mesh glass = flatBox({-2, -2, -1}, {2, 2, 1});
+    test::append(glass, flatBox({-1.8f, -1.8f, -0.8f}, {1.8f, 1.8f, 0.8f}, /*inward=*/true));
     Scene s = sceneOf(glass, 1.5, /*priority=*/1);
     Part water;
     water.name = "water";
-    water.mesh = flatBox({-0.85f, -0.85f, -0.85f}, {0.85f, 0.85f, 0.2f});
+    water.mesh = flatBox({-1.85f, -1.85f, -0.95f}, {1.85f, 1.85f, 0.2f});
     water.medium.ior = 1.33;
     water.medium.priority = 2;
     s.parts.push_back(water);
     Tracer tracer(s);
-    const float theta = 30;
+    const float theta = 60;
     glm::vec3 omega = fromAngles(theta, 180);  // viewer toward -x, the path travels +x
-    PathResult r = tracer.trace({-0.3f, 0, 1}, {0, 0, 1}, omega, 0);
+    PathResult r = tracer.trace({-1.0f, 0, 1}, {0, 0, 1}, omega, 0);
     auto cosIn = [&](double n) { double st = std::sin(theta * kPi / 180) / n; return std::sqrt(1 - st * st); };
-    // Glass 1.0 -> 0.8, air 0.8 -> 0.2, water 0.2 -> -0.85 (overlap included), glass -0.85 -> -1.
-    double expected = 0.2 / cosIn(1.5) + 1.05 / cosIn(1.33) + 0.15 / cosIn(1.5);
+    // Glass 1.0 -> 0.8, air 0.8 -> 0.2, water 0.2 -> -0.95 (overlap included), glass -0.95 -> -1.
+    double expected = 0.2 / cosIn(1.5) + 1.15 / cosIn(1.33) + 0.05 / cosIn(1.5);
     double ifGlassWon = 0.2 / cosIn(1.5) + 1.0 / cosIn(1.33) + 0.2 / cosIn(1.5);
-    ASSERT_GT(std::abs(expected - ifGlassWon), 1e-3);
+    ASSERT_GT(std::abs(expected - ifGlassWon), 1e-2);
     EXPECT_NEAR(r.length, expected, 1e-4);
     EXPECT_NEAR(glm::dot(r.exit, -omega), 1.0f, 1e-5f) << str(r.exit);
     EXPECT_EQ(r.flags & (kPathLeaked | kPathCapped), 0u);

@@ -1,0 +1,726 @@
+// NAME.shrefract.exr: one multi-part OpenEXR file (layout in docs/format.md).
+//
+// Parts, all scanline, ZIP, data window (0,0)-(w-1,h-1), looked up by name:
+//   "weights"         mu layout   w###.x/.y/.z/.len (FLOAT or HALF), or w###.rgba8 (UINT, U8)
+//   "samples"         mu layout   P.x P.y P.z N.x N.y N.z (FLOAT), part (UINT)
+//   "rho"             rho layout  kind a b c (UINT)
+//   "neighbours"      mu layout   offset count (UINT)
+//   "neighbour_list"  near-square index (UINT), weight (FLOAT); entry e at (e % w, e / w)
+// The JSON manifest sits in the string attribute "shrefract.manifest" of every part.
+#include <Iex.h>
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputPart.h>
+#include <ImfMultiPartInputFile.h>
+#include <ImfMultiPartOutputFile.h>
+#include <ImfOutputPart.h>
+#include <ImfPartType.h>
+#include <ImfStdIO.h>
+#include <ImfStringAttribute.h>
+#include <fcntl.h>
+#include <half.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+#include "common/bakefile.h"
+#include "common/error.h"
+#include "common/sh.h"
+
+namespace shrefract {
+
+const char* ToString(Precision p) {
+    switch (p) {
+        case Precision::F32:
+            return "f32";
+        case Precision::F16:
+            return "f16";
+        case Precision::U8:
+            return "u8";
+    }
+    return "unknown";
+}
+
+Precision parsePrecision(const std::string& text) {
+    if (text == "f32") return Precision::F32;
+    if (text == "f16") return Precision::F16;
+    if (text == "u8") return Precision::U8;
+    throw InputError("unknown weight precision \"" + text + "\" (expected f32, f16 or u8)");
+}
+
+int BakeData::coefficientCount() const { return shEvenCount(order); }
+
+namespace {
+
+using nlohmann::json;
+
+constexpr const char* kManifestAttribute = "shrefract.manifest";
+constexpr const char* kWeightsPart = "weights";
+constexpr const char* kSamplesPart = "samples";
+constexpr const char* kRhoPart = "rho";
+constexpr const char* kNeighboursPart = "neighbours";
+constexpr const char* kNeighbourListPart = "neighbour_list";
+// Rows staged per writePixels/readPixels call for the weights part (a ZIP block is 16 lines), so
+// that the weights are never duplicated in memory at full size.
+constexpr int kChunkRows = 16;
+constexpr const char* kWeightSuffix[4] = {"x", "y", "z", "len"};
+
+std::string weightChannel(int k, const char* suffix) {
+    char name[32];
+    std::snprintf(name, sizeof name, "w%03d.%s", k, suffix);
+    return name;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Staging: the channels of one part (or of a band of rows of it), interleaved per texel.
+
+struct Channel {
+    std::string name;
+    Imf::PixelType type;
+};
+
+size_t pixelSize(Imf::PixelType t) { return t == Imf::HALF ? 2 : 4; }
+const char* pixelTypeName(Imf::PixelType t) {
+    return t == Imf::UINT    ? "UINT"
+           : t == Imf::HALF  ? "HALF"
+           : t == Imf::FLOAT ? "FLOAT"
+                             : "unknown";
+}
+
+class Planes {
+public:
+    Planes(int width, int rows, std::vector<Channel> channels)
+        : width_(width), rows_(rows), channels_(std::move(channels)) {
+        for (const Channel& c : channels_) {
+            offset_.push_back(stride_);
+            stride_ += pixelSize(c.type);
+        }
+        bytes_.assign(size_t(width_) * rows_ * stride_, 0);
+    }
+    // Texel t counts row-major from the first staged row.
+    void setU(size_t t, int c, uint32_t v) { std::memcpy(at(t, c), &v, 4); }
+    void setF(size_t t, int c, float v) { std::memcpy(at(t, c), &v, 4); }
+    void setH(size_t t, int c, float v) {
+        half h(v);
+        std::memcpy(at(t, c), &h, 2);
+    }
+    uint32_t u(size_t t, int c) const {
+        uint32_t v;
+        std::memcpy(&v, at(t, c), 4);
+        return v;
+    }
+    float f(size_t t, int c) const {
+        float v;
+        std::memcpy(&v, at(t, c), 4);
+        return v;
+    }
+    float h(size_t t, int c) const {
+        half v;
+        std::memcpy(&v, at(t, c), 2);
+        return float(v);
+    }
+    // A frame buffer whose row y0 is the first staged row.
+    Imf::FrameBuffer frameBuffer(int y0) {
+        const size_t yStride = stride_ * width_;
+        Imf::FrameBuffer fb;
+        for (size_t c = 0; c < channels_.size(); ++c) {
+            char* base = reinterpret_cast<char*>(bytes_.data()) + offset_[c] -
+                         static_cast<std::ptrdiff_t>(y0) * static_cast<std::ptrdiff_t>(yStride);
+            fb.insert(channels_[c].name, Imf::Slice(channels_[c].type, base, stride_, yStride));
+        }
+        return fb;
+    }
+    const std::vector<Channel>& channels() const { return channels_; }
+
+private:
+    unsigned char* at(size_t t, int c) { return bytes_.data() + t * stride_ + offset_[c]; }
+    const unsigned char* at(size_t t, int c) const {
+        return bytes_.data() + t * stride_ + offset_[c];
+    }
+    int width_, rows_;
+    std::vector<Channel> channels_;
+    std::vector<size_t> offset_;
+    size_t stride_ = 0;
+    std::vector<unsigned char> bytes_;
+};
+
+std::vector<Channel> weightChannels(int K, Precision p) {
+    std::vector<Channel> ch;
+    for (int k = 0; k < K; ++k) {
+        if (p == Precision::U8) {
+            ch.push_back({weightChannel(k, "rgba8"), Imf::UINT});
+        } else {
+            for (const char* s : kWeightSuffix)
+                ch.push_back({weightChannel(k, s), p == Precision::F16 ? Imf::HALF : Imf::FLOAT});
+        }
+    }
+    return ch;
+}
+const std::vector<Channel> kSampleChannels = {
+    {"P.x", Imf::FLOAT}, {"P.y", Imf::FLOAT}, {"P.z", Imf::FLOAT}, {"N.x", Imf::FLOAT},
+    {"N.y", Imf::FLOAT}, {"N.z", Imf::FLOAT}, {"part", Imf::UINT}};
+const std::vector<Channel> kRhoChannels = {
+    {"kind", Imf::UINT}, {"a", Imf::UINT}, {"b", Imf::UINT}, {"c", Imf::UINT}};
+const std::vector<Channel> kNeighbourChannels = {{"offset", Imf::UINT}, {"count", Imf::UINT}};
+const std::vector<Channel> kNeighbourListChannels = {{"index", Imf::UINT}, {"weight", Imf::FLOAT}};
+
+// ---------------------------------------------------------------------------------------------
+// 8-bit weights: value = scale * code + offset, per coefficient k and channel c.
+
+// Scale and offset are kept in double precision (the manifest stores them as JSON numbers) and
+// the decode rounds to float once, so that code 0 gives the minimum and code 255 the maximum
+// exactly. (With a float scale lo + 255 * scale lands on a grid about two float ulps apart and
+// often misses the maximum.)
+float dequantU8(double scale, double offset, uint32_t code) {
+    return static_cast<float>(scale * double(code) + offset);
+}
+
+// (hi - lo) / 255, nudged by a few double ulps should code 255 not decode to hi exactly.
+double fitScale(float lo, float hi) {
+    if (!(hi > lo)) return 0.0;  // constant channel: every code decodes to lo
+    const double s = (double(hi) - double(lo)) / 255.0;
+    double up = s, down = s;
+    for (int step = 0; step < 16; ++step) {
+        if (dequantU8(up, lo, 255) == hi) return up;
+        if (dequantU8(down, lo, 255) == hi) return down;
+        up = std::nextafter(up, INFINITY);
+        down = std::nextafter(down, 0.0);
+    }
+    return s;
+}
+
+uint32_t quantU8(float v, double scale, double offset) {
+    if (scale == 0.0) return 0;
+    const double code = std::nearbyint((double(v) - offset) / scale);
+    return static_cast<uint32_t>(std::clamp(code, 0.0, 255.0));
+}
+
+struct U8Params {
+    std::vector<double> scale, offset;  // [k * 4 + c]
+};
+
+U8Params fitU8(const BakeData& d) {
+    const int K = d.coefficientCount();
+    const size_t N = d.layout.position.size();
+    U8Params q;
+    q.scale.assign(size_t(K) * 4, 0.0);
+    q.offset.assign(size_t(K) * 4, 0.0);
+    for (int k = 0; k < K; ++k) {
+        for (int c = 0; c < 4; ++c) {
+            float lo = INFINITY, hi = -INFINITY;
+            for (size_t i = 0; i < N; ++i) {
+                const float v = d.weights[(size_t(k) * N + i) * 4 + c];
+                if (!std::isfinite(v)) {
+                    throw std::invalid_argument("writeBake: weight " + std::to_string(k) +
+                                                " of sample " + std::to_string(i) + " channel " +
+                                                kWeightSuffix[c] + " is not finite");
+                }
+                lo = std::min(lo, v);
+                hi = std::max(hi, v);
+            }
+            if (N == 0) lo = hi = 0.0f;
+            q.offset[k * 4 + c] = lo;
+            q.scale[k * 4 + c] = fitScale(lo, hi);
+        }
+    }
+    return q;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Consistency of a BakeData, shared by writer (a caller bug: std::invalid_argument) and reader
+// (a bad file: InputError). Returns what is wrong, or "" when consistent.
+
+template <class... T>
+std::string str(const T&... parts) {
+    std::ostringstream os;
+    (os << ... << parts);
+    return os.str();
+}
+
+std::string inconsistency(const BakeData& d) {
+    const SurfaceLayout& L = d.layout;
+    if (d.order < 0) return str("order ", d.order, " is negative");
+    const size_t K = size_t(d.coefficientCount());
+    const size_t N = L.position.size();
+    if (L.normal.size() != N || L.part.size() != N)
+        return str("per-sample arrays differ in size: position ", N, ", normal ", L.normal.size(),
+                   ", part ", L.part.size());
+    if (L.muWidth < 1 || L.muHeight < 1)
+        return str("mu layout is ", L.muWidth, " x ", L.muHeight, " texels");
+    if (N > size_t(L.muWidth) * size_t(L.muHeight))
+        return str(N, " samples do not fit the ", L.muWidth, " x ", L.muHeight, " mu layout");
+    if (L.rhoWidth < 1 || L.rhoHeight < 1)
+        return str("rho layout is ", L.rhoWidth, " x ", L.rhoHeight, " texels");
+    if (L.rho.size() != size_t(L.rhoWidth) * size_t(L.rhoHeight))
+        return str("rho has ", L.rho.size(), " texels, expected ", L.rhoWidth, " x ", L.rhoHeight);
+    if (L.rate < 1) return str("rate ", L.rate, " is below 1");
+    if (L.triangleCount < 0) return str("triangle count ", L.triangleCount, " is negative");
+    if (L.triangleCount > 0) {
+        if (L.blockWidth < 1 || L.blockHeight < 1 || L.blocksPerRow < 1)
+            return str("rho blocks are ", L.blockWidth, " x ", L.blockHeight, ", ", L.blocksPerRow,
+                       " per row");
+        const int64_t blocks = (int64_t(L.triangleCount) + 1) / 2;
+        const int64_t blockRows = (blocks + L.blocksPerRow - 1) / L.blocksPerRow;
+        if (int64_t(L.blocksPerRow) * L.blockWidth > L.rhoWidth ||
+            blockRows * L.blockHeight > L.rhoHeight)
+            return str(L.triangleCount, " triangles in ", L.blockWidth, " x ", L.blockHeight,
+                       " blocks, ", L.blocksPerRow, " per row, do not fit the ", L.rhoWidth, " x ",
+                       L.rhoHeight, " rho layout");
+    }
+    for (size_t t = 0; t < L.rho.size(); ++t) {
+        const RhoTexel& r = L.rho[t];
+        const int x = int(t % size_t(L.rhoWidth)), y = int(t / size_t(L.rhoWidth));
+        if (r.kind > RhoTexel::Correction)
+            return str("rho texel (", x, ", ", y, ") has unknown kind ", r.kind);
+        const bool bad = (r.kind == RhoTexel::Sample && r.a >= N) ||
+                         (r.kind == RhoTexel::Correction && (r.a >= N || r.b >= N || r.c >= N));
+        if (bad)
+            return str("rho texel (", x, ", ", y, ") refers to samples (", r.a, ", ", r.b, ", ",
+                       r.c, ") but there are only ", N);
+    }
+    if (L.neighbourOffset.size() != N || L.neighbourCount.size() != N)
+        return str("neighbour offsets (", L.neighbourOffset.size(), ") and counts (",
+                   L.neighbourCount.size(), ") are not one per sample (", N, ")");
+    const size_t E = L.neighbourIndex.size();
+    if (L.neighbourWeight.size() != E)
+        return str(E, " neighbour indices but ", L.neighbourWeight.size(), " weights");
+    for (size_t i = 0; i < N; ++i) {
+        if (uint64_t(L.neighbourOffset[i]) + L.neighbourCount[i] > E)
+            return str("neighbours of sample ", i, " (offset ", L.neighbourOffset[i], ", count ",
+                       L.neighbourCount[i], ") run past the list of ", E);
+    }
+    for (size_t e = 0; e < E; ++e) {
+        if (L.neighbourIndex[e] >= N)
+            return str("neighbour list entry ", e, " refers to sample ", L.neighbourIndex[e],
+                       " but there are only ", N);
+    }
+    if (d.weights.size() != K * N * 4)
+        return str(d.weights.size(), " weights, expected ", K, " coefficients x ", N,
+                   " samples x 4");
+    return "";
+}
+
+// Near-square: width ceil(sqrt(E)), at least one texel.
+std::pair<int, int> neighbourListSize(size_t E) {
+    if (E == 0) return {1, 1};
+    int w = static_cast<int>(std::ceil(std::sqrt(double(E))));
+    while (size_t(w) * size_t(w) < E) ++w;
+    const int h = static_cast<int>((E + size_t(w) - 1) / size_t(w));
+    return {w, h};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Writing.
+
+Imf::Header partHeader(const char* name, int width, int height, const Imath::Box2i& display,
+                       const std::string& manifest) {
+    Imf::Header h(width, height);
+    h.displayWindow() = display;  // shared by all parts of a multi-part file
+    h.setName(name);
+    h.setType(Imf::SCANLINEIMAGE);
+    h.compression() = Imf::ZIP_COMPRESSION;
+    h.insert(kManifestAttribute, Imf::StringAttribute(manifest));
+    return h;
+}
+
+void addChannels(Imf::Header& h, const std::vector<Channel>& channels) {
+    for (const Channel& c : channels) h.channels().insert(c.name, Imf::Channel(c.type));
+}
+
+void writeWhole(Imf::MultiPartOutputFile& file, int part, Planes& planes, int height) {
+    Imf::OutputPart out(file, part);
+    out.setFrameBuffer(planes.frameBuffer(0));
+    out.writePixels(height);
+}
+
+void writeWeights(Imf::MultiPartOutputFile& file, int part, const BakeData& d, const U8Params& u8) {
+    const SurfaceLayout& L = d.layout;
+    const int K = d.coefficientCount();
+    const size_t N = L.position.size();
+    Imf::OutputPart out(file, part);
+    for (int y0 = 0; y0 < L.muHeight; y0 += kChunkRows) {
+        const int rows = std::min(kChunkRows, L.muHeight - y0);
+        Planes chunk(L.muWidth, rows, weightChannels(K, d.precision));
+        for (size_t t = 0; t < size_t(L.muWidth) * rows; ++t) {
+            const size_t i = size_t(y0) * L.muWidth + t;
+            if (i >= N) break;  // texels past the last sample stay zero
+            for (int k = 0; k < K; ++k) {
+                const float* w = &d.weights[(size_t(k) * N + i) * 4];
+                if (d.precision == Precision::U8) {
+                    uint32_t packed = 0;
+                    for (int c = 0; c < 4; ++c)
+                        packed |= quantU8(w[c], u8.scale[k * 4 + c], u8.offset[k * 4 + c])
+                                  << (8 * c);
+                    chunk.setU(t, k, packed);
+                    continue;
+                }
+                for (int c = 0; c < 4; ++c) {
+                    if (!std::isfinite(w[c]))
+                        throw std::invalid_argument(str("writeBake: weight ", k, " of sample ", i,
+                                                        " channel ", kWeightSuffix[c],
+                                                        " is not finite"));
+                    if (d.precision == Precision::F16)
+                        chunk.setH(t, k * 4 + c, w[c]);
+                    else
+                        chunk.setF(t, k * 4 + c, w[c]);
+                }
+            }
+        }
+        out.setFrameBuffer(chunk.frameBuffer(y0));
+        out.writePixels(rows);
+    }
+}
+
+// Flushes the file's data to disk before the rename makes it visible under its final name.
+void syncFile(const std::string& path) {
+    const int fd = ::open(path.c_str(), O_RDONLY);
+    if (fd < 0) return;
+    ::fsync(fd);
+    ::close(fd);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reading.
+
+int manifestInt(const json& m, const char* key) {
+    auto it = m.find(key);
+    if (it == m.end() || !it->is_number_integer())
+        throw InputError(str("manifest has no integer \"", key, "\""));
+    return it->get<int>();
+}
+
+std::vector<int> manifestInts(const json& m, const char* key, size_t n) {
+    auto it = m.find(key);
+    if (it == m.end() || !it->is_array() || it->size() != n)
+        throw InputError(str("manifest has no \"", key, "\" array of ", n, " integers"));
+    std::vector<int> v;
+    for (const json& x : *it) {
+        if (!x.is_number_integer())
+            throw InputError(str("manifest has no \"", key, "\" array of ", n, " integers"));
+        v.push_back(x.get<int>());
+    }
+    return v;
+}
+
+std::vector<double> manifestNumbers(const json& m, const char* key, size_t n) {
+    if (!m.is_object() || !m.contains(key) || !m[key].is_array() || m[key].size() != n)
+        throw InputError(str("manifest has no u8 \"", key, "\" array of ", n, " numbers"));
+    std::vector<double> v;
+    for (const json& x : m[key]) {
+        if (!x.is_number() || !std::isfinite(x.get<double>()))
+            throw InputError(str("manifest u8 \"", key, "\" holds a non-number"));
+        v.push_back(x.get<double>());
+    }
+    return v;
+}
+
+// Checks that `part` is a scanline part of width x height with the channels (and types) given.
+void checkPart(const Imf::Header& h, const char* name, int width, int height,
+               const std::vector<Channel>& channels) {
+    if (h.hasType() && h.type() != Imf::SCANLINEIMAGE)
+        throw InputError(str("part \"", name, "\" is not a scanline image"));
+    const Imath::Box2i& dw = h.dataWindow();
+    if (dw.min.x != 0 || dw.min.y != 0 || dw.max.x != width - 1 || dw.max.y != height - 1)
+        throw InputError(str("part \"", name, "\" has data window (", dw.min.x, ",", dw.min.y,
+                             ")-(", dw.max.x, ",", dw.max.y, "), expected (0,0)-(", width - 1, ",",
+                             height - 1, ")"));
+    for (const Channel& c : channels) {
+        const Imf::Channel* found = h.channels().findChannel(c.name);
+        if (!found) throw InputError(str("part \"", name, "\" has no channel \"", c.name, "\""));
+        if (found->type != c.type)
+            throw InputError(str("part \"", name, "\" channel \"", c.name, "\" is ",
+                                 pixelTypeName(found->type), ", expected ", pixelTypeName(c.type)));
+    }
+}
+
+void readWhole(Imf::MultiPartInputFile& file, int part, Planes& planes, int height) {
+    Imf::InputPart in(file, part);
+    in.setFrameBuffer(planes.frameBuffer(0));
+    in.readPixels(0, height - 1);
+}
+
+BakeData readParts(Imf::MultiPartInputFile& file) {
+    // The manifest of the first part is the one that counts.
+    const auto* text = file.header(0).findTypedAttribute<Imf::StringAttribute>(kManifestAttribute);
+    if (!text) throw InputError("not a shrefract bake (no \"shrefract.manifest\" attribute)");
+    json m = json::parse(text->value(), nullptr, /*allow_exceptions=*/false);
+    if (m.is_discarded() || !m.is_object())
+        throw InputError("not a shrefract bake (the manifest is not a JSON object)");
+    if (!m.contains("format") || m["format"] != "shrefract")
+        throw InputError("not a shrefract bake (manifest \"format\" is not \"shrefract\")");
+    const int version = manifestInt(m, "version");
+    if (version > kFormatVersion)
+        throw InputError(str("format version ", version, " is newer than this build reads (",
+                             kFormatVersion, ")"));
+    if (version < 1) throw InputError(str("format version ", version, " is invalid"));
+
+    BakeData d;
+    d.order = manifestInt(m, "order");
+    if (d.order < 0 || d.order > 100) throw InputError(str("SH order ", d.order, " is absurd"));
+    const int K = d.coefficientCount();
+    if (manifestInt(m, "coefficients") != K)
+        throw InputError(str("manifest says ", manifestInt(m, "coefficients"),
+                             " coefficients, order ", d.order, " has ", K));
+    if (!m.contains("precision") || !m["precision"].is_string())
+        throw InputError("manifest has no \"precision\"");
+    d.precision = parsePrecision(m["precision"].get<std::string>());
+
+    SurfaceLayout& L = d.layout;
+    const int N = manifestInt(m, "sampleCount");
+    const std::vector<int> mu = manifestInts(m, "mu", 2), rho = manifestInts(m, "rho", 2),
+                           block = manifestInts(m, "block", 3);
+    L.muWidth = mu[0], L.muHeight = mu[1];
+    L.rhoWidth = rho[0], L.rhoHeight = rho[1];
+    L.blockWidth = block[0], L.blockHeight = block[1], L.blocksPerRow = block[2];
+    L.triangleCount = manifestInt(m, "triangleCount");
+    L.rate = manifestInt(m, "rate");
+    const int nlWidth = manifestInt(m, "neighbourListWidth");
+    const int nlLength = manifestInt(m, "neighbourListLength");
+    if (L.muWidth < 1 || L.muHeight < 1 || L.rhoWidth < 1 || L.rhoHeight < 1 || nlWidth < 1)
+        throw InputError(str("manifest sizes are invalid: mu ", L.muWidth, " x ", L.muHeight,
+                             ", rho ", L.rhoWidth, " x ", L.rhoHeight, ", neighbour list width ",
+                             nlWidth));
+    if (N < 0 || int64_t(N) > int64_t(L.muWidth) * L.muHeight)
+        throw InputError(
+            str(N, " samples do not fit the ", L.muWidth, " x ", L.muHeight, " mu layout"));
+    if (nlLength < 0) throw InputError(str("neighbour list length ", nlLength, " is negative"));
+    U8Params u8;
+    if (d.precision == Precision::U8) {
+        if (!m.contains("u8")) throw InputError("8-bit bake without \"u8\" scale and offset");
+        u8.scale = manifestNumbers(m["u8"], "scale", size_t(K) * 4);
+        u8.offset = manifestNumbers(m["u8"], "offset", size_t(K) * 4);
+        d.u8Scale.assign(u8.scale.begin(), u8.scale.end());
+        d.u8Offset.assign(u8.offset.begin(), u8.offset.end());
+    }
+
+    std::map<std::string, int> parts;
+    for (int p = 0; p < file.parts(); ++p)
+        if (file.header(p).hasName()) parts[file.header(p).name()] = p;
+    auto find = [&](const char* name) {
+        auto it = parts.find(name);
+        if (it == parts.end()) throw InputError(str("missing part \"", name, "\""));
+        return it->second;
+    };
+    const int pWeights = find(kWeightsPart), pSamples = find(kSamplesPart), pRho = find(kRhoPart),
+              pNeighbours = find(kNeighboursPart), pList = find(kNeighbourListPart);
+    const std::vector<Channel> wChannels = weightChannels(K, d.precision);
+    checkPart(file.header(pWeights), kWeightsPart, L.muWidth, L.muHeight, wChannels);
+    checkPart(file.header(pSamples), kSamplesPart, L.muWidth, L.muHeight, kSampleChannels);
+    checkPart(file.header(pRho), kRhoPart, L.rhoWidth, L.rhoHeight, kRhoChannels);
+    checkPart(file.header(pNeighbours), kNeighboursPart, L.muWidth, L.muHeight, kNeighbourChannels);
+    const Imath::Box2i& listWindow = file.header(pList).dataWindow();
+    const int nlHeight = listWindow.max.y - listWindow.min.y + 1;
+    checkPart(file.header(pList), kNeighbourListPart, nlWidth, nlHeight, kNeighbourListChannels);
+    if (int64_t(nlWidth) * nlHeight < nlLength)
+        throw InputError(str("neighbour list of ", nlLength, " entries does not fit its ", nlWidth,
+                             " x ", nlHeight, " part"));
+
+    // Weights, a band of rows at a time, dequantized to float.
+    d.weights.assign(size_t(K) * N * 4, 0.0f);
+    {
+        Imf::InputPart in(file, pWeights);
+        for (int y0 = 0; y0 < L.muHeight && int64_t(y0) * L.muWidth < N; y0 += kChunkRows) {
+            const int rows = std::min(kChunkRows, L.muHeight - y0);
+            Planes chunk(L.muWidth, rows, wChannels);
+            in.setFrameBuffer(chunk.frameBuffer(y0));
+            in.readPixels(y0, y0 + rows - 1);
+            for (size_t t = 0; t < size_t(L.muWidth) * rows; ++t) {
+                const size_t i = size_t(y0) * L.muWidth + t;
+                if (i >= size_t(N)) break;
+                for (int k = 0; k < K; ++k) {
+                    float* w = &d.weights[(size_t(k) * N + i) * 4];
+                    if (d.precision == Precision::U8) {
+                        const uint32_t packed = chunk.u(t, k);
+                        for (int c = 0; c < 4; ++c)
+                            w[c] = dequantU8(u8.scale[k * 4 + c], u8.offset[k * 4 + c],
+                                             (packed >> (8 * c)) & 0xffu);
+                    } else {
+                        for (int c = 0; c < 4; ++c)
+                            w[c] = d.precision == Precision::F16 ? chunk.h(t, k * 4 + c)
+                                                                 : chunk.f(t, k * 4 + c);
+                    }
+                }
+            }
+        }
+    }
+
+    Planes samples(L.muWidth, L.muHeight, kSampleChannels);
+    readWhole(file, pSamples, samples, L.muHeight);
+    Planes neighbours(L.muWidth, L.muHeight, kNeighbourChannels);
+    readWhole(file, pNeighbours, neighbours, L.muHeight);
+    L.position.resize(N);
+    L.normal.resize(N);
+    L.part.resize(N);
+    L.neighbourOffset.resize(N);
+    L.neighbourCount.resize(N);
+    for (int i = 0; i < N; ++i) {
+        L.position[i] = {samples.f(i, 0), samples.f(i, 1), samples.f(i, 2)};
+        L.normal[i] = {samples.f(i, 3), samples.f(i, 4), samples.f(i, 5)};
+        L.part[i] = samples.u(i, 6);
+        L.neighbourOffset[i] = neighbours.u(i, 0);
+        L.neighbourCount[i] = neighbours.u(i, 1);
+    }
+
+    Planes rhoPlanes(L.rhoWidth, L.rhoHeight, kRhoChannels);
+    readWhole(file, pRho, rhoPlanes, L.rhoHeight);
+    L.rho.resize(size_t(L.rhoWidth) * L.rhoHeight);
+    for (size_t t = 0; t < L.rho.size(); ++t)
+        L.rho[t] = {rhoPlanes.u(t, 0), rhoPlanes.u(t, 1), rhoPlanes.u(t, 2), rhoPlanes.u(t, 3)};
+
+    Planes list(nlWidth, nlHeight, kNeighbourListChannels);
+    readWhole(file, pList, list, nlHeight);
+    L.neighbourIndex.resize(nlLength);
+    L.neighbourWeight.resize(nlLength);
+    for (int e = 0; e < nlLength; ++e) {
+        L.neighbourIndex[e] = list.u(e, 0);
+        L.neighbourWeight[e] = list.f(e, 1);
+    }
+
+    const std::string problem = inconsistency(d);
+    if (!problem.empty()) throw InputError("inconsistent bake: " + problem);
+    d.manifest = std::move(m);
+    return d;
+}
+
+}  // namespace
+
+void writeBake(const std::string& path, const BakeData& data) {
+    // Everything that can be checked is checked before the temporary file exists.
+    const std::string problem = inconsistency(data);
+    if (!problem.empty()) throw std::invalid_argument("writeBake(" + path + "): " + problem);
+    if (!data.manifest.is_null() && !data.manifest.is_object())
+        throw std::invalid_argument("writeBake(" + path + "): the manifest is not a JSON object");
+    const SurfaceLayout& L = data.layout;
+    const U8Params u8 = data.precision == Precision::U8 ? fitU8(data) : U8Params{};
+    const auto [nlWidth, nlHeight] = neighbourListSize(L.neighbourIndex.size());
+
+    json m = data.manifest.is_null() ? json::object() : data.manifest;
+    m["format"] = "shrefract";
+    m["version"] = kFormatVersion;
+    m["order"] = data.order;
+    m["coefficients"] = data.coefficientCount();
+    m["precision"] = ToString(data.precision);
+    m["sampleCount"] = L.sampleCount();
+    m["mu"] = {L.muWidth, L.muHeight};
+    m["rho"] = {L.rhoWidth, L.rhoHeight};
+    m["block"] = {L.blockWidth, L.blockHeight, L.blocksPerRow};
+    m["triangleCount"] = L.triangleCount;
+    m["rate"] = L.rate;
+    m["neighbourListWidth"] = nlWidth;
+    m["neighbourListLength"] = L.neighbourIndex.size();
+    if (data.precision == Precision::U8)
+        m["u8"] = {{"scale", u8.scale}, {"offset", u8.offset}};
+    else
+        m.erase("u8");
+    std::string text;
+    try {
+        text = m.dump();
+    } catch (const json::exception& e) {
+        throw std::invalid_argument("writeBake(" + path + "): manifest: " + e.what());
+    }
+
+    const Imath::Box2i display({0, 0}, {L.muWidth - 1, L.muHeight - 1});
+    std::vector<Imf::Header> headers = {
+        partHeader(kWeightsPart, L.muWidth, L.muHeight, display, text),
+        partHeader(kSamplesPart, L.muWidth, L.muHeight, display, text),
+        partHeader(kRhoPart, L.rhoWidth, L.rhoHeight, display, text),
+        partHeader(kNeighboursPart, L.muWidth, L.muHeight, display, text),
+        partHeader(kNeighbourListPart, nlWidth, nlHeight, display, text)};
+    addChannels(headers[0], weightChannels(data.coefficientCount(), data.precision));
+    addChannels(headers[1], kSampleChannels);
+    addChannels(headers[2], kRhoChannels);
+    addChannels(headers[3], kNeighbourChannels);
+    addChannels(headers[4], kNeighbourListChannels);
+
+    const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+    try {
+        std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
+        if (!os) throw inputError(path, str("cannot create ", tmp, ": ", std::strerror(errno)));
+        {
+            Imf::StdOFStream stream(os, tmp.c_str());
+            Imf::MultiPartOutputFile file(stream, headers.data(), int(headers.size()));
+            writeWeights(file, 0, data, u8);
+
+            Planes samples(L.muWidth, L.muHeight, kSampleChannels);
+            Planes neighbours(L.muWidth, L.muHeight, kNeighbourChannels);
+            for (int i = 0; i < L.sampleCount(); ++i) {
+                for (int c = 0; c < 3; ++c) {
+                    samples.setF(i, c, L.position[i][c]);
+                    samples.setF(i, 3 + c, L.normal[i][c]);
+                }
+                samples.setU(i, 6, L.part[i]);
+                neighbours.setU(i, 0, L.neighbourOffset[i]);
+                neighbours.setU(i, 1, L.neighbourCount[i]);
+            }
+            writeWhole(file, 1, samples, L.muHeight);
+
+            Planes rho(L.rhoWidth, L.rhoHeight, kRhoChannels);
+            for (size_t t = 0; t < L.rho.size(); ++t) {
+                rho.setU(t, 0, L.rho[t].kind);
+                rho.setU(t, 1, L.rho[t].a);
+                rho.setU(t, 2, L.rho[t].b);
+                rho.setU(t, 3, L.rho[t].c);
+            }
+            writeWhole(file, 2, rho, L.rhoHeight);
+            writeWhole(file, 3, neighbours, L.muHeight);
+
+            Planes list(nlWidth, nlHeight, kNeighbourListChannels);
+            for (size_t e = 0; e < L.neighbourIndex.size(); ++e) {
+                list.setU(e, 0, L.neighbourIndex[e]);
+                list.setF(e, 1, L.neighbourWeight[e]);
+            }
+            writeWhole(file, 4, list, nlHeight);
+        }  // the destructor writes the chunk offset tables; it swallows errors, the stream not
+        os.flush();
+        os.close();
+        if (os.fail())
+            throw inputError(path, str("cannot write ", tmp, ": ", std::strerror(errno)));
+        syncFile(tmp);
+        if (std::rename(tmp.c_str(), path.c_str()) != 0)
+            throw inputError(path, str("cannot rename ", tmp, " to it: ", std::strerror(errno)));
+    } catch (const Iex::BaseExc& e) {
+        std::remove(tmp.c_str());
+        throw inputError(path, str("cannot write: ", e.what()));
+    } catch (...) {
+        std::remove(tmp.c_str());
+        throw;
+    }
+}
+
+BakeData readBake(const std::string& path) {
+    std::error_code ec;
+    const auto status = std::filesystem::status(path, ec);
+    if (!std::filesystem::exists(status)) throw inputError(path, "file not found");
+    if (std::filesystem::is_directory(status))
+        throw inputError(path, "is a directory, not a bake file");
+
+    std::unique_ptr<Imf::MultiPartInputFile> file;
+    try {
+        file = std::make_unique<Imf::MultiPartInputFile>(path.c_str());
+    } catch (const std::exception& e) {
+        throw inputError(path, str("not an OpenEXR file: ", e.what()));
+    }
+    try {
+        return readParts(*file);
+    } catch (const InputError& e) {
+        throw inputError(path, e.what());
+    } catch (const Iex::BaseExc& e) {
+        throw inputError(path, str("truncated or corrupt: ", e.what()));
+    } catch (const std::bad_alloc&) {
+        throw inputError(path, "sizes too large to load");
+    }
+}
+
+}  // namespace shrefract

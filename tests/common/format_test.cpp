@@ -1,0 +1,558 @@
+// Round trips and failure modes of NAME.shrefract.exr (common/bakefile.h, docs/format.md).
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputPart.h>
+#include <ImfMultiPartInputFile.h>
+#include <ImfMultiPartOutputFile.h>
+#include <ImfOutputPart.h>
+#include <ImfRgbaFile.h>
+#include <ImfStringAttribute.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "common/bakefile.h"
+#include "common/error.h"
+#include "common/sh.h"
+
+namespace shrefract {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// A scratch folder per test, so that tests may run in parallel and "no temporary file is left"
+// looks only at this test's files.
+fs::path scratch() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    const fs::path dir = fs::path(SHREFRACT_TEST_TMP) / "format" / info->name();
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+std::string readBytes(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void writeBytes(const fs::path& p, const std::string& bytes) {
+    std::ofstream out(p, std::ios::binary);
+    out << bytes;
+}
+
+std::vector<std::string> leftovers(const fs::path& dir) {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir)) {
+        const std::string name = e.path().filename().string();
+        if (name.find(".tmp.") != std::string::npos) names.push_back(name);
+    }
+    return names;
+}
+
+// Order 4 (15 stored coefficients), 37 samples in a 7 x 6 mu layout, 3 triangles at rate 2 in
+// 4 x 4 blocks (2 per row) of an 8 x 8 rho layout holding all three texel kinds, and neighbour
+// lists of 1..4 entries. Weights in [-1, 1] for x, y, z and lengths in [0, 3].
+BakeData syntheticBake(Precision precision, uint32_t seed = 7) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f), length(0.0f, 3.0f);
+    BakeData d;
+    d.order = 4;
+    d.precision = precision;
+    SurfaceLayout& L = d.layout;
+    const int N = 37;
+    L.rate = 2;
+    L.muWidth = 7, L.muHeight = 6;
+    for (int i = 0; i < N; ++i) {
+        L.position.push_back({unit(rng), unit(rng), unit(rng)});
+        L.normal.push_back(glm::normalize(glm::vec3(unit(rng), unit(rng), 1.5f)));
+        L.part.push_back(uint32_t(i % 3));
+    }
+    L.rhoWidth = 8, L.rhoHeight = 8;
+    L.blockWidth = 4, L.blockHeight = 4, L.blocksPerRow = 2;
+    L.triangleCount = 3;
+    L.rho.resize(64);
+    for (int t = 0; t < 64; ++t) {
+        RhoTexel& r = L.rho[t];
+        r.kind = uint32_t(t % 3);
+        if (r.kind == RhoTexel::Sample) r.a = uint32_t((t * 5) % N);
+        if (r.kind == RhoTexel::Correction)
+            r.a = uint32_t(t % N), r.b = uint32_t((t + 1) % N), r.c = uint32_t((t + 11) % N);
+    }
+    for (int i = 0; i < N; ++i) {
+        const uint32_t count = 1 + uint32_t(i % 4);
+        L.neighbourOffset.push_back(uint32_t(L.neighbourIndex.size()));
+        L.neighbourCount.push_back(count);
+        for (uint32_t j = 0; j < count; ++j) {
+            L.neighbourIndex.push_back(uint32_t((i + 3 * j) % N));  // itself first
+            L.neighbourWeight.push_back(1.0f / float(count));
+        }
+    }
+    const int K = d.coefficientCount();
+    d.weights.resize(size_t(K) * N * 4);
+    for (size_t v = 0; v < d.weights.size(); ++v)
+        d.weights[v] = v % 4 == 3 ? length(rng) : unit(rng);
+    d.manifest = {
+        {"grid", {{"theta", 32}, {"phi", 64}}},
+        {"filter", {{"kind", "semi-gaussian"}, {"width", 0.25}}},
+        {"media", json::array({{{"name", "glass"}, {"ior", 1.5}}})},
+        {"meshChecksum", "fnv1a64:0123456789abcdef"},
+        {"shConvention", "real, orthonormal, no Condon-Shortley phase"},
+        {"stats", {{"tirPaths", 12}, {"cappedPaths", 0}}},
+        {"order", 99},  // stale: writeBake overrides it
+        {"u8", "stale"},
+    };
+    return d;
+}
+
+void expectLayoutEqual(const SurfaceLayout& a, const SurfaceLayout& b) {
+    EXPECT_EQ(a.rate, b.rate);
+    EXPECT_EQ(a.muWidth, b.muWidth);
+    EXPECT_EQ(a.muHeight, b.muHeight);
+    EXPECT_EQ(a.rhoWidth, b.rhoWidth);
+    EXPECT_EQ(a.rhoHeight, b.rhoHeight);
+    EXPECT_EQ(a.blockWidth, b.blockWidth);
+    EXPECT_EQ(a.blockHeight, b.blockHeight);
+    EXPECT_EQ(a.blocksPerRow, b.blocksPerRow);
+    EXPECT_EQ(a.triangleCount, b.triangleCount);
+    ASSERT_EQ(a.sampleCount(), b.sampleCount());
+    for (int i = 0; i < a.sampleCount(); ++i) {
+        EXPECT_EQ(a.position[i], b.position[i]) << "sample " << i;
+        EXPECT_EQ(a.normal[i], b.normal[i]) << "sample " << i;
+    }
+    EXPECT_EQ(a.part, b.part);
+    ASSERT_EQ(a.rho.size(), b.rho.size());
+    for (size_t t = 0; t < a.rho.size(); ++t) {
+        EXPECT_EQ(a.rho[t].kind, b.rho[t].kind) << "texel " << t;
+        EXPECT_EQ(a.rho[t].a, b.rho[t].a) << "texel " << t;
+        EXPECT_EQ(a.rho[t].b, b.rho[t].b) << "texel " << t;
+        EXPECT_EQ(a.rho[t].c, b.rho[t].c) << "texel " << t;
+    }
+    EXPECT_EQ(a.neighbourOffset, b.neighbourOffset);
+    EXPECT_EQ(a.neighbourCount, b.neighbourCount);
+    EXPECT_EQ(a.neighbourIndex, b.neighbourIndex);
+    EXPECT_EQ(a.neighbourWeight, b.neighbourWeight);
+}
+
+// Copies a bake part by part, channel by channel, letting the test edit the manifest (of every
+// part) and the raw pixels: a way to make files that writeBake would never write.
+using PixelEdit = std::function<void(const std::string& part, const std::string& channel,
+                                     std::vector<char>& bytes)>;
+void rewrite(const fs::path& src, const fs::path& dst, const std::function<void(json&)>& edit,
+             const PixelEdit& pixels = nullptr) {
+    Imf::MultiPartInputFile in(src.c_str());
+    std::vector<Imf::Header> headers;
+    for (int p = 0; p < in.parts(); ++p) {
+        Imf::Header h = in.header(p);
+        auto& attr = h.typedAttribute<Imf::StringAttribute>("shrefract.manifest");
+        json m = json::parse(attr.value());
+        edit(m);
+        attr.value() = m.dump();
+        headers.push_back(h);
+    }
+    Imf::MultiPartOutputFile out(dst.c_str(), headers.data(), int(headers.size()));
+    for (int p = 0; p < in.parts(); ++p) {
+        const Imath::Box2i dw = headers[p].dataWindow();
+        const int w = dw.max.x + 1, h = dw.max.y + 1;
+        std::vector<std::pair<std::string, std::vector<char>>> planes;
+        Imf::FrameBuffer fb;
+        for (auto c = headers[p].channels().begin(); c != headers[p].channels().end(); ++c) {
+            const size_t size = c.channel().type == Imf::HALF ? 2 : 4;
+            planes.emplace_back(c.name(), std::vector<char>(size * w * h));
+        }
+        auto c = headers[p].channels().begin();
+        for (auto& [name, bytes] : planes) {
+            const size_t size = bytes.size() / (size_t(w) * h);
+            fb.insert(name, Imf::Slice(c.channel().type, bytes.data(), size, size * w));
+            ++c;
+        }
+        Imf::InputPart ip(in, p);
+        ip.setFrameBuffer(fb);
+        ip.readPixels(0, h - 1);
+        if (pixels)
+            for (auto& [name, bytes] : planes) pixels(headers[p].name(), name, bytes);
+        Imf::OutputPart op(out, p);
+        op.setFrameBuffer(fb);
+        op.writePixels(h);
+    }
+}
+
+// Expects readBake(path) to throw InputError whose message names the file and contains `what`.
+void expectInputError(const fs::path& path, const std::string& what) {
+    try {
+        readBake(path.string());
+        FAIL() << "readBake(" << path << ") did not throw";
+    } catch (const InputError& e) {
+        const std::string msg = e.what();
+        EXPECT_NE(msg.find(path.string()), std::string::npos) << msg;
+        EXPECT_NE(msg.find(what), std::string::npos) << msg;
+    }
+}
+
+TEST(Format, PrecisionNamesRoundTrip) {
+    for (Precision p : {Precision::F32, Precision::F16, Precision::U8})
+        EXPECT_EQ(parsePrecision(ToString(p)), p) << ToString(p);
+    EXPECT_THROW(parsePrecision("f64"), InputError);
+    EXPECT_THROW(parsePrecision("F32"), InputError);
+}
+
+TEST(Format, CoefficientCountIsEvenParityCount) {
+    BakeData d;
+    d.order = 8;
+    EXPECT_EQ(d.coefficientCount(), 45);  // DESIGN.md §2: 45 of 81 at L = 8
+    d.order = 4;
+    EXPECT_EQ(d.coefficientCount(), 15);
+}
+
+TEST(Format, RoundTripF32IsExact) {
+    const fs::path path = scratch() / "f32.shrefract.exr";
+    const BakeData d = syntheticBake(Precision::F32);
+    writeBake(path.string(), d);
+    const BakeData r = readBake(path.string());
+    EXPECT_EQ(r.order, d.order);
+    EXPECT_EQ(r.precision, Precision::F32);
+    ASSERT_EQ(r.weights.size(), d.weights.size());
+    for (size_t v = 0; v < d.weights.size(); ++v)
+        ASSERT_EQ(r.weights[v], d.weights[v]) << "weight " << v;
+    EXPECT_TRUE(r.u8Scale.empty());
+    EXPECT_TRUE(r.u8Offset.empty());
+    EXPECT_TRUE(leftovers(path.parent_path()).empty());
+}
+
+TEST(Format, RoundTripF16WithinHalfPrecision) {
+    const fs::path path = scratch() / "f16.shrefract.exr";
+    const BakeData d = syntheticBake(Precision::F16);
+    writeBake(path.string(), d);
+    const BakeData r = readBake(path.string());
+    EXPECT_EQ(r.precision, Precision::F16);
+    ASSERT_EQ(r.weights.size(), d.weights.size());
+    int inexact = 0;
+    for (size_t v = 0; v < d.weights.size(); ++v) {
+        // Round to nearest with an 11-bit significand: relative error 2^-11; subnormal halves
+        // below 2^-14 are spaced 2^-24 apart.
+        const float tol = std::abs(d.weights[v]) * std::ldexp(1.0f, -11) + std::ldexp(1.0f, -25);
+        ASSERT_LE(std::abs(r.weights[v] - d.weights[v]), tol) << "weight " << v;
+        inexact += r.weights[v] != d.weights[v];
+    }
+    EXPECT_GT(inexact, 0) << "the weights were not stored as half";
+}
+
+TEST(Format, RoundTripU8WithinHalfAStep) {
+    const fs::path path = scratch() / "u8.shrefract.exr";
+    const BakeData d = syntheticBake(Precision::U8);
+    writeBake(path.string(), d);
+    const BakeData r = readBake(path.string());
+    EXPECT_EQ(r.precision, Precision::U8);
+    const int K = d.coefficientCount();
+    const size_t N = size_t(d.layout.sampleCount());
+    ASSERT_EQ(r.u8Scale.size(), size_t(K) * 4);
+    ASSERT_EQ(r.u8Offset.size(), size_t(K) * 4);
+    ASSERT_EQ(r.weights.size(), d.weights.size());
+    for (int k = 0; k < K; ++k) {
+        for (int c = 0; c < 4; ++c) {
+            float lo = INFINITY, hi = -INFINITY;
+            size_t iLo = 0, iHi = 0;
+            for (size_t i = 0; i < N; ++i) {
+                const float v = d.weights[(k * N + i) * 4 + c];
+                if (v < lo) lo = v, iLo = i;
+                if (v > hi) hi = v, iHi = i;
+            }
+            const float scale = r.u8Scale[k * 4 + c];
+            EXPECT_EQ(r.u8Offset[k * 4 + c], lo);
+            EXPECT_NEAR(scale, (hi - lo) / 255.0f, 1e-6f * (hi - lo));
+            // The extremes decode exactly, everything else within half a step.
+            EXPECT_EQ(r.weights[(k * N + iLo) * 4 + c], lo) << "k " << k << " c " << c;
+            EXPECT_EQ(r.weights[(k * N + iHi) * 4 + c], hi) << "k " << k << " c " << c;
+            for (size_t i = 0; i < N; ++i) {
+                const size_t v = (k * N + i) * 4 + c;
+                ASSERT_LE(std::abs(r.weights[v] - d.weights[v]), scale * 0.5f * (1 + 1e-5f))
+                    << "k " << k << " c " << c << " sample " << i;
+            }
+        }
+    }
+}
+
+TEST(Format, U8ConstantChannelDecodesExactly) {
+    const fs::path path = scratch() / "u8const.shrefract.exr";
+    BakeData d = syntheticBake(Precision::U8);
+    const size_t N = size_t(d.layout.sampleCount());
+    for (size_t i = 0; i < N; ++i) d.weights[(2 * N + i) * 4 + 1] = -0.3f;  // k 2, channel y
+    writeBake(path.string(), d);
+    const BakeData r = readBake(path.string());
+    EXPECT_EQ(r.u8Scale[2 * 4 + 1], 0.0f);
+    for (size_t i = 0; i < N; ++i) EXPECT_EQ(r.weights[(2 * N + i) * 4 + 1], -0.3f);
+}
+
+TEST(Format, ManifestKeepsCallerFieldsAndAddsLayout) {
+    const fs::path dir = scratch();
+    const BakeData d = syntheticBake(Precision::U8);
+    writeBake((dir / "a.shrefract.exr").string(), d);
+    const json m = readBake((dir / "a.shrefract.exr").string()).manifest;
+    for (const char* key : {"grid", "filter", "media", "meshChecksum", "shConvention", "stats"})
+        EXPECT_EQ(m.at(key), d.manifest.at(key)) << key;
+    EXPECT_EQ(m.at("format"), "shrefract");
+    EXPECT_EQ(m.at("version"), kFormatVersion);
+    EXPECT_EQ(m.at("order"), 4);  // the caller's stale 99 is overridden
+    EXPECT_EQ(m.at("coefficients"), 15);
+    EXPECT_EQ(m.at("precision"), "u8");
+    EXPECT_EQ(m.at("sampleCount"), 37);
+    EXPECT_EQ(m.at("mu"), json::array({7, 6}));
+    EXPECT_EQ(m.at("rho"), json::array({8, 8}));
+    EXPECT_EQ(m.at("block"), json::array({4, 4, 2}));
+    EXPECT_EQ(m.at("triangleCount"), 3);
+    EXPECT_EQ(m.at("rate"), 2);
+    EXPECT_EQ(m.at("neighbourListLength"), d.layout.neighbourIndex.size());
+    EXPECT_EQ(m.at("neighbourListWidth"), 10);  // ceil(sqrt(91))
+    EXPECT_EQ(m.at("u8").at("scale").size(), 60u);
+    EXPECT_EQ(m.at("u8").at("offset").size(), 60u);
+
+    // Not U8: no stale "u8" survives.
+    BakeData f = syntheticBake(Precision::F16);
+    writeBake((dir / "b.shrefract.exr").string(), f);
+    const json mf = readBake((dir / "b.shrefract.exr").string()).manifest;
+    EXPECT_EQ(mf.at("precision"), "f16");
+    EXPECT_FALSE(mf.contains("u8"));
+
+    // Every part carries the manifest, for tools that pull one part out.
+    Imf::MultiPartInputFile file((dir / "a.shrefract.exr").c_str());
+    ASSERT_EQ(file.parts(), 5);
+    const std::vector<std::string> names = {"weights", "samples", "rho", "neighbours",
+                                            "neighbour_list"};
+    for (int p = 0; p < file.parts(); ++p) {
+        EXPECT_EQ(file.header(p).name(), names[p]);
+        EXPECT_EQ(file.header(p).compression(), Imf::ZIP_COMPRESSION);
+        const auto* a =
+            file.header(p).findTypedAttribute<Imf::StringAttribute>("shrefract.manifest");
+        ASSERT_NE(a, nullptr) << names[p];
+        EXPECT_EQ(json::parse(a->value()), m) << names[p];
+    }
+}
+
+TEST(Format, LayoutArraysSurviveRoundTrip) {
+    const fs::path dir = scratch();
+    for (Precision p : {Precision::F32, Precision::F16, Precision::U8}) {
+        const fs::path path = dir / (std::string(ToString(p)) + ".shrefract.exr");
+        const BakeData d = syntheticBake(p, 11);
+        writeBake(path.string(), d);
+        SCOPED_TRACE(ToString(p));
+        expectLayoutEqual(readBake(path.string()).layout, d.layout);
+    }
+}
+
+TEST(Format, EmptyNeighbourListRoundTrips) {
+    const fs::path path = scratch() / "noneighbours.shrefract.exr";
+    BakeData d = syntheticBake(Precision::F32);
+    std::fill(d.layout.neighbourCount.begin(), d.layout.neighbourCount.end(), 0u);
+    std::fill(d.layout.neighbourOffset.begin(), d.layout.neighbourOffset.end(), 0u);
+    d.layout.neighbourIndex.clear();
+    d.layout.neighbourWeight.clear();
+    writeBake(path.string(), d);
+    expectLayoutEqual(readBake(path.string()).layout, d.layout);
+}
+
+TEST(Format, MissingFileIsReported) {
+    expectInputError(scratch() / "nothing.shrefract.exr", "file not found");
+}
+
+TEST(Format, NonExrFileIsReported) {
+    const fs::path path = scratch() / "text.shrefract.exr";
+    writeBytes(path, "this is a text file, not an image\n");
+    expectInputError(path, "not an OpenEXR file");
+}
+
+TEST(Format, PlainExrIsNotABake) {
+    const fs::path path = scratch() / "rgba.exr";
+    {
+        std::vector<Imf::Rgba> pixels(16, Imf::Rgba(0.5f, 0.25f, 0.125f, 1.0f));
+        Imf::RgbaOutputFile out(path.c_str(), 4, 4, Imf::WRITE_RGBA);
+        out.setFrameBuffer(pixels.data(), 1, 4);
+        out.writePixels(4);
+    }
+    expectInputError(path, "not a shrefract bake");
+}
+
+TEST(Format, NewerVersionIsRejected) {
+    const fs::path dir = scratch();
+    writeBake((dir / "ok.shrefract.exr").string(), syntheticBake(Precision::F32));
+    rewrite(dir / "ok.shrefract.exr", dir / "v2.shrefract.exr",
+            [](json& m) { m["version"] = kFormatVersion + 1; });
+    expectInputError(dir / "v2.shrefract.exr", "format version " +
+                                                   std::to_string(kFormatVersion + 1) +
+                                                   " is newer than this build reads (" +
+                                                   std::to_string(kFormatVersion) + ")");
+    // The copy itself is faithful: with the version left alone it reads back.
+    rewrite(dir / "ok.shrefract.exr", dir / "v1.shrefract.exr", [](json&) {});
+    EXPECT_NO_THROW(readBake((dir / "v1.shrefract.exr").string()));
+}
+
+TEST(Format, TruncatedFileIsReported) {
+    const fs::path dir = scratch();
+    writeBake((dir / "ok.shrefract.exr").string(), syntheticBake(Precision::F32));
+    const std::string bytes = readBytes(dir / "ok.shrefract.exr");
+    writeBytes(dir / "half.shrefract.exr", bytes.substr(0, bytes.size() / 2));
+    expectInputError(dir / "half.shrefract.exr", "");
+}
+
+TEST(Format, InconsistentSizesAreReported) {
+    const fs::path dir = scratch();
+    const fs::path ok = dir / "ok.shrefract.exr";
+    writeBake(ok.string(), syntheticBake(Precision::F32));
+    rewrite(ok, dir / "many.shrefract.exr", [](json& m) { m["sampleCount"] = 43; });
+    expectInputError(dir / "many.shrefract.exr", "do not fit the 7 x 6 mu layout");
+    rewrite(ok, dir / "mu.shrefract.exr", [](json& m) { m["mu"] = {6, 7}; });
+    expectInputError(dir / "mu.shrefract.exr", "data window");
+    rewrite(ok, dir / "order.shrefract.exr", [](json& m) { m["order"] = 5; });
+    expectInputError(dir / "order.shrefract.exr", "coefficients");
+    rewrite(ok, dir / "noformat.shrefract.exr", [](json& m) { m.erase("format"); });
+    expectInputError(dir / "noformat.shrefract.exr", "not a shrefract bake");
+    rewrite(ok, dir / "prec.shrefract.exr", [](json& m) { m["precision"] = "f16"; });
+    expectInputError(dir / "prec.shrefract.exr", "\"w000.x\" is FLOAT, expected HALF");
+    // A rho texel that points past the samples, and a neighbour run past the list.
+    rewrite(
+        ok, dir / "rho.shrefract.exr", [](json&) {},
+        [](const std::string& part, const std::string& channel, std::vector<char>& bytes) {
+            const uint32_t bad = 37;
+            if (part == "rho" && channel == "a") std::memcpy(&bytes[4 * 1], &bad, 4);
+        });
+    expectInputError(dir / "rho.shrefract.exr", "rho texel (1, 0) refers to samples (37");
+    rewrite(
+        ok, dir / "list.shrefract.exr", [](json&) {},
+        [](const std::string& part, const std::string& channel, std::vector<char>& bytes) {
+            const uint32_t bad = 91;  // count 1: runs to 92 > 91 entries
+            if (part == "neighbours" && channel == "offset") std::memcpy(&bytes[4 * 36], &bad, 4);
+        });
+    expectInputError(dir / "list.shrefract.exr", "neighbours of sample 36");
+}
+
+TEST(Format, WriteIntoMissingDirectoryLeavesNothing) {
+    const fs::path dir = scratch();
+    const fs::path path = dir / "missing" / "out.shrefract.exr";
+    try {
+        writeBake(path.string(), syntheticBake(Precision::F32));
+        FAIL() << "writeBake did not throw";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(dir / "missing"));
+    EXPECT_TRUE(fs::is_empty(dir));
+}
+
+TEST(Format, FailedWriteLeavesOldFileUntouched) {
+    const fs::path dir = scratch();
+    const fs::path path = dir / "bake.shrefract.exr";
+    writeBake(path.string(), syntheticBake(Precision::F32, 1));
+    const std::string before = readBytes(path);
+
+    // Caught before the temporary file is opened: sizes that do not agree.
+    BakeData sizes = syntheticBake(Precision::F32, 2);
+    sizes.weights.pop_back();
+    EXPECT_THROW(writeBake(path.string(), sizes), std::invalid_argument);
+    BakeData rho = syntheticBake(Precision::F32, 2);
+    rho.layout.rho[5] = {RhoTexel::Sample, 1000, 0, 0};
+    EXPECT_THROW(writeBake(path.string(), rho), std::invalid_argument);
+    EXPECT_EQ(readBytes(path), before);
+
+    // Caught midway, with the temporary file half written: a NaN weight in the last sample.
+    BakeData nan = syntheticBake(Precision::F32, 2);
+    nan.weights.back() = NAN;
+    EXPECT_THROW(writeBake(path.string(), nan), std::invalid_argument);
+    EXPECT_EQ(readBytes(path), before);
+    EXPECT_EQ(leftovers(dir), std::vector<std::string>{});
+
+    // U8 finds it while fitting the scales.
+    nan.precision = Precision::U8;
+    EXPECT_THROW(writeBake(path.string(), nan), std::invalid_argument);
+    EXPECT_EQ(readBytes(path), before);
+    EXPECT_EQ(leftovers(dir), std::vector<std::string>{});
+}
+
+TEST(Format, FailedRenameRemovesTemporary) {
+    // Renaming a file over a non-empty directory fails after the whole file was written.
+    const fs::path dir = scratch();
+    const fs::path path = dir / "taken.shrefract.exr";
+    fs::create_directories(path / "inside");
+    try {
+        writeBake(path.string(), syntheticBake(Precision::F16));
+        FAIL() << "writeBake did not throw";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
+    }
+    EXPECT_TRUE(fs::is_directory(path / "inside"));
+    EXPECT_EQ(leftovers(dir), std::vector<std::string>{});
+}
+
+TEST(Format, OverwriteReplacesOldFile) {
+    const fs::path path = scratch() / "bake.shrefract.exr";
+    writeBake(path.string(), syntheticBake(Precision::F32, 1));
+    const BakeData d = syntheticBake(Precision::F16, 2);
+    writeBake(path.string(), d);
+    const BakeData r = readBake(path.string());
+    EXPECT_EQ(r.precision, Precision::F16);
+    expectLayoutEqual(r.layout, d.layout);
+}
+
+// The sizes docs/format.md quotes: order 8 (45 coefficients), a 256 x 256 mu layout, weights that
+// vary smoothly over the surface (as baked weights do, mostly) plus noise at the 8-bit step.
+TEST(Format, WeightBytesPerTexelPerCoefficient) {
+    const fs::path dir = scratch();
+    const int W = 256, H = 256, N = W * H;
+    BakeData d;
+    d.order = 8;
+    SurfaceLayout& L = d.layout;
+    L.muWidth = W, L.muHeight = H;
+    L.rhoWidth = L.rhoHeight = 1;
+    L.rho.resize(1);
+    L.position.resize(N);
+    L.normal.assign(N, glm::vec3(0, 0, 1));
+    L.part.assign(N, 0);
+    L.neighbourOffset.assign(N, 0);
+    L.neighbourCount.assign(N, 0);
+    const int K = d.coefficientCount();
+    std::mt19937 rng(3);
+    std::normal_distribution<float> noise(0.0f, 1.0f / 512);
+    d.weights.resize(size_t(K) * N * 4);
+    for (int k = 0; k < K; ++k)
+        for (int i = 0; i < N; ++i)
+            for (int c = 0; c < 4; ++c) {
+                const float x = float(i % W) / W, y = float(i / W) / H;
+                d.weights[(size_t(k) * N + i) * 4 + c] =
+                    std::sin(6.0f * x + k + c) * std::cos(4.0f * y - c) / (1 + k) + noise(rng);
+            }
+    // Each precision against the same bake at order 0 (one coefficient): the difference is what
+    // the other 44 coefficients cost.
+    BakeData order0 = d;
+    order0.order = 0;
+    order0.weights.resize(size_t(N) * 4);
+    double perTexel[3];
+    int j = 0;
+    for (Precision p : {Precision::F32, Precision::F16, Precision::U8}) {
+        d.precision = order0.precision = p;
+        const fs::path path = dir / (std::string(ToString(p)) + ".exr");
+        const fs::path path0 = dir / (std::string(ToString(p)) + "-order0.exr");
+        writeBake(path.string(), d);
+        writeBake(path0.string(), order0);
+        const double size = double(fs::file_size(path)), size0 = double(fs::file_size(path0));
+        perTexel[j++] = (size - size0) / (double(N) * (K - 1));
+        std::printf(
+            "[ sizes    ] %s: %.0f bytes (order 0: %.0f), %.3f bytes per texel per "
+            "coefficient\n",
+            ToString(p), size, size0, perTexel[j - 1]);
+    }
+    EXPECT_GT(perTexel[0], perTexel[1]);
+    EXPECT_GT(perTexel[1], perTexel[2]);
+    EXPECT_LE(perTexel[0], 16.5);  // never much above the uncompressed 16 bytes
+}
+
+}  // namespace
+}  // namespace shrefract

@@ -148,7 +148,12 @@ public:
         if (!context_) throw ContextError("OSMesa: cannot create a 3.3 core profile context");
         makeCurrent();
     }
-    ~OSMesaContext() override { OSMesaLib::get(false).destroyContext(context_); }
+    ~OSMesaContext() override {
+        OSMesaLib& lib = OSMesaLib::get(false);
+        // Release first, so that OSMesaGetCurrentContext() no longer names a dead context.
+        if (lib.getCurrentContext() == context_) lib.makeCurrent(nullptr, nullptr, 0, 0, 0);
+        lib.destroyContext(context_);
+    }
     void makeCurrent() override {
         if (!OSMesaLib::get(false).makeCurrent(context_, buffer_.data(), GL_UNSIGNED_BYTE,
                                                width_, height_))

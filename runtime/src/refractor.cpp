@@ -102,6 +102,9 @@ struct Refractor::Impl {
     }
     void end(Stage s, double* ms) {
         if (!options.timings) return;
+        // Software rasterizers (llvmpipe) defer the work to a flush; finish inside the query so
+        // that the stage's time is measured, not only its submission.
+        glFinish();
         glEndQuery(GL_TIME_ELAPSED);
         GLuint64 ns = 0;
         glGetQueryObjectui64v(queries[s], GL_QUERY_RESULT, &ns);
@@ -135,6 +138,15 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
     m->options = options;
     m->loader = options.loader ? options.loader : currentContextLoader();
     m->use();
+    // Without a current context GLVND's dispatch returns null for everything.
+    const GLubyte* version = glGetString(GL_VERSION);
+    if (!version) throw std::runtime_error("shrefract: no current OpenGL context");
+    GLint major = 0, minor = 0;
+    glGetIntegerv(GL_MAJOR_VERSION, &major);
+    glGetIntegerv(GL_MINOR_VERSION, &minor);
+    if (major * 10 + minor < 33)
+        throw std::runtime_error(std::string("shrefract: needs OpenGL 3.3 core, context is ") +
+                                 reinterpret_cast<const char*>(version));
     const BakeData& d = bake.data();
     const SurfaceLayout& L = d.layout;
     const int n = L.sampleCount();

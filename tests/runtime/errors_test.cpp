@@ -5,8 +5,11 @@
 #include <filesystem>
 #include <fstream>
 
+#include "common/bakefile.h"
 #include "common/error.h"
+#include "test_bake.h"
 #include "shrefract/context.h"
+#include "shrefract/render.h"
 #include "shrefract/runtime.h"
 
 namespace shrefract {
@@ -49,6 +52,10 @@ TEST(RuntimeErrors, UnknownBackendIsRefused) {
     EXPECT_THROW(parseBackend("vulkan"), std::invalid_argument);
 }
 
+void writeExrForTest(const std::string& path, int w, int h, const std::vector<float>& rgba) {
+    writeExr(path, w, h, rgba);
+}
+
 int run(const std::string& args, const fs::path& log) {
     std::string cmd = std::string(SHREFRACT_RENDER_EXE) + " " + args + " > " + log.string() + " 2>&1";
     int status = std::system(cmd.c_str());
@@ -81,6 +88,43 @@ TEST(RenderCli, BadInputExitsNonZeroWithoutOutput) {
         EXPECT_NE(msg.find(c.expect), std::string::npos) << msg;
         EXPECT_FALSE(fs::exists(out)) << c.args;
     }
+}
+
+TEST(RuntimeErrors, RefractorNeedsACurrentContext) {
+    Bake bake = makeBake(test::randomBake(1, 1));
+    RefractorOptions o;
+    o.loader = createHeadlessContext(Backend::Egl)->loader();  // context gone again at once
+    EXPECT_THROW(Refractor::create(bake, o), std::runtime_error);
+}
+
+// A 2x1 lat-long EXR, enough for an environment.
+void writeTinyEnv(const fs::path& p) {
+    std::vector<float> rgba = {1, 1, 1, 1, 0.5f, 0.5f, 0.5f, 1};
+    writeExrForTest(p.string(), 2, 1, rgba);
+}
+
+// End to end: a bake written with writeBake, rendered by the CLI; then the same bake with a
+// missing environment fails without output.
+TEST(RenderCli, RendersABakeAndRefusesAMissingEnvironment) {
+    fs::path d = tmpDir();
+    fs::path bakePath = d / "octa.shrefract.exr", env = d / "env.exr", log = d / "cli.txt";
+    writeBake(bakePath.string(), test::randomBake(4, 2));
+    writeTinyEnv(env);
+    fs::path png = d / "octa.png", exr = d / "octa.exr", dirs = d / "dirs.exr";
+    for (const fs::path& p : {png, exr, dirs}) fs::remove(p);
+    std::string common = bakePath.string() + " --size 64x48 --camera orbit:20,10,3.5";
+    ASSERT_EQ(run(common + " --env " + env.string() + " --out " + png.string() + " --out-exr " +
+                      exr.string() + " --dirs " + dirs.string() + " --dump-shaders " +
+                      (d / "shaders").string(),
+                  log), 0)
+        << slurp(log);
+    std::printf("%s", slurp(log).c_str());
+    for (const fs::path& p : {png, exr, dirs}) EXPECT_TRUE(fs::exists(p)) << p;
+    EXPECT_TRUE(fs::exists(d / "shaders" / "decompress_pass1.frag"));
+    fs::remove(png);
+    EXPECT_NE(run(common + " --env " + (d / "nope.exr").string() + " --out " + png.string(), log), 0);
+    EXPECT_NE(slurp(log).find("nope.exr"), std::string::npos) << slurp(log);
+    EXPECT_FALSE(fs::exists(png));
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 //                    [--out-exr IMG.exr] [--dirs DIRS.exr] [--dump-shaders DIR]
 // A thin shell over the runtime library (shrefract/render.h). Bad input: message, exit 1, and
 // no output file.
+#include <algorithm>
 #include <cstdio>
 #include <sstream>
 #include <string>
@@ -43,7 +44,7 @@ int main(int argc, char** argv) {
     std::string bakePath, envPath, camera, eye, target, size = "1024x1024", backend = "egl";
     std::string out, outExr, dirs, dumpDir, preset = "modern";
     float fov = 45.0f, exposure = 1.0f;
-    int order = -1;
+    int order = -1, frames = 5;
     bool smoothing = false;
     app.add_option("bake", bakePath, "NAME.shrefract.exr from shrefract-bake")->required();
     app.add_option("--env", envPath, "lat-long environment EXR")->required();
@@ -55,6 +56,7 @@ int main(int argc, char** argv) {
     app.add_option("--order", order, "SH order used at runtime (default: all stored)");
     app.add_option("--backend", backend, "headless GL: egl | osmesa")->capture_default_str();
     app.add_option("--preset", preset, "shader limits: modern | 2006")->capture_default_str();
+    app.add_option("--frames", frames, "frames timed after a warm-up one")->capture_default_str();
     app.add_flag("--smooth", smoothing, "spatial smoothing through the neighbour lists");
     app.add_option("--exposure", exposure, "exposure before the tone map")->capture_default_str();
     app.add_option("--out", out, "tone-mapped PNG");
@@ -106,8 +108,28 @@ int main(int argc, char** argv) {
                     refractor->order(), refractor->passCount(), preset.c_str());
         if (!dumpDir.empty()) refractor->dumpShaders(dumpDir);
 
-        shrefract::RenderedFrame frame = shrefract::renderFrame(*refractor, env, cam, width, height);
-        const shrefract::Timings& t = frame.timings;
+        // A first frame warms up shader compilation (llvmpipe JIT-compiles at first draw); the
+        // timings printed are the per-stage medians of the `frames` frames after it.
+        shrefract::renderFrame(*refractor, env, cam, width, height);
+        shrefract::RenderedFrame frame;
+        std::vector<shrefract::Timings> all;
+        for (int f = 0; f < std::max(1, frames); ++f) {
+            frame = shrefract::renderFrame(*refractor, env, cam, width, height);
+            all.push_back(frame.timings);
+        }
+        auto median = [&](double shrefract::Timings::*field) {
+            std::vector<double> v;
+            for (const auto& x : all) v.push_back(x.*field);
+            std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+            return v[v.size() / 2];
+        };
+        shrefract::Timings t = frame.timings;
+        t.view = median(&shrefract::Timings::view);
+        t.decompress = median(&shrefract::Timings::decompress);
+        t.smooth = median(&shrefract::Timings::smooth);
+        t.unpack = median(&shrefract::Timings::unpack);
+        t.shade = median(&shrefract::Timings::shade);
+        std::printf("frames: %d timed (median per stage)\n", static_cast<int>(all.size()));
         std::printf("GPU ms: view %.3f, decompress %.3f (%d passes), smooth %.3f, unpack %.3f, "
                     "shade %.3f\n",
                     t.view, t.decompress, t.passes, t.smooth, t.unpack, t.shade);

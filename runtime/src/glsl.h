@@ -133,8 +133,10 @@ vec3 toneMap(vec3 c) {
 
 void main() {
     vec4 r = texture(uRho, vUV);
-    vec3 exitWorld = normalize(uModelRotation * normalize(r.xyz));
     vec3 v = normalize(uEye - vPosition);
+    // A (near) zero interpolated direction has no direction: go straight through, never NaN.
+    float len2 = dot(r.xyz, r.xyz);
+    vec3 exitWorld = len2 > 1e-20 ? normalize(uModelRotation * (r.xyz * inversesqrt(len2))) : -v;
     vec3 n = normalize(vNormal);
     float F = fresnelDielectric(dot(n, v), uEta);
     vec3 transmitted = texture(uEnvironment, exitWorld).rgb * exp(-uKappa * max(r.w, 0.0));

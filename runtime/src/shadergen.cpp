@@ -158,7 +158,10 @@ std::string fragmentSource(const DecompressionShaders& s, int index, const PassP
         std::string fetch = l.weightArray
                                 ? "texelFetch(uWeights, ivec3(p, " + std::to_string(k) + "), 0)"
                                 : "texelFetch(uWeight" + std::to_string(k) + ", p, 0)";
+        // The label, then the exact expansion (integer numerators, one scale) it comes from.
+        std::string exact = p.ToString();
         o << "    // y_" << p.l << "^" << p.m << "\n"
+          << "    //   " << exact.substr(exact.find('=')) << "\n"
           << "    s += " << fetch << " * (" << polyExpression(p) << ");\n";
     }
     o << "    oSum = s;\n}\n";

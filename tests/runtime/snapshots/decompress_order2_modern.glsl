@@ -24,16 +24,22 @@ void main() {
     float z2 = z * z;
     float xy = x * y;
     // y_0^0
+    //   = 0.28209479177387814 * (1)
     s += texelFetch(uWeights, ivec3(p, 0), 0) * (0.282094792);
     // y_1^-1
+    //   = 0.48860251190291992 * (y)
     s += texelFetch(uWeights, ivec3(p, 1), 0) * (0.488602512 * y);
     // y_1^1
+    //   = 0.48860251190291992 * (x)
     s += texelFetch(uWeights, ivec3(p, 2), 0) * (0.488602512 * x);
     // y_2^-2
+    //   = 1.0925484305920792 * (x y)
     s += texelFetch(uWeights, ivec3(p, 3), 0) * (1.09254843 * xy);
     // y_2^0
+    //   = 0.31539156525251999 * (3 z^2 - 1)
     s += texelFetch(uWeights, ivec3(p, 4), 0) * (0.946174696 * z2 - 0.315391565);
     // y_2^2
+    //   = 0.54627421529603959 * (x^2 - y^2)
     s += texelFetch(uWeights, ivec3(p, 5), 0) * (0.546274215 * x2 - 0.546274215 * y2);
     oSum = s;
 }

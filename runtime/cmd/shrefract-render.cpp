@@ -1,0 +1,147 @@
+// shrefract-render: renders a bake in front of an environment, headless (EGL or OSMesa).
+//   shrefract-render BAKE --env ENV.exr [--camera orbit:AZ,EL,DIST | --eye x,y,z --target x,y,z]
+//                    [--fov deg] [--size WxH] [--order L] [--backend egl|osmesa] [--out IMG.png]
+//                    [--out-exr IMG.exr] [--dirs DIRS.exr] [--dump-shaders DIR]
+// A thin shell over the runtime library (shrefract/render.h). Bad input: message, exit 1, and
+// no output file.
+#include <algorithm>
+#include <cstdio>
+#include <sstream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "common/error.h"
+#include "shrefract/context.h"
+#include "shrefract/render.h"
+#include "shrefract/runtime.h"
+
+namespace {
+
+std::vector<float> parseFloats(const std::string& text, size_t count, const std::string& what) {
+    std::vector<float> v;
+    std::stringstream ss(text);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        try {
+            size_t used = 0;
+            v.push_back(std::stof(item, &used));
+            if (used != item.size()) throw std::invalid_argument(item);
+        } catch (const std::exception&) {
+            throw std::invalid_argument(what + ": '" + text + "' is not a list of numbers");
+        }
+    }
+    if (v.size() != count)
+        throw std::invalid_argument(what + ": expected " + std::to_string(count) + " numbers, got '" +
+                                    text + "'");
+    return v;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"Render a shrefract bake (interactive refraction, Genevaux et al. 2006) headless"};
+    std::string bakePath, envPath, camera, eye, target, size = "1024x1024", backend = "egl";
+    std::string out, outExr, dirs, dumpDir, preset = "modern";
+    float fov = 45.0f, exposure = 1.0f;
+    int order = -1, frames = 5;
+    bool smoothing = false;
+    app.add_option("bake", bakePath, "NAME.shrefract.exr from shrefract-bake")->required();
+    app.add_option("--env", envPath, "lat-long environment EXR")->required();
+    app.add_option("--camera", camera, "orbit:AZ,EL,DIST (degrees, degrees, object units)");
+    app.add_option("--eye", eye, "camera position x,y,z (with --target)");
+    app.add_option("--target", target, "camera target x,y,z");
+    app.add_option("--fov", fov, "vertical field of view, degrees")->capture_default_str();
+    app.add_option("--size", size, "image size WxH")->capture_default_str();
+    app.add_option("--order", order, "SH order used at runtime (default: all stored)");
+    app.add_option("--backend", backend, "headless GL: egl | osmesa")->capture_default_str();
+    app.add_option("--preset", preset, "shader limits: modern | 2006")->capture_default_str();
+    app.add_option("--frames", frames, "frames timed after a warm-up one")->capture_default_str();
+    app.add_flag("--smooth", smoothing, "spatial smoothing through the neighbour lists");
+    app.add_option("--exposure", exposure, "exposure before the tone map")->capture_default_str();
+    app.add_option("--out", out, "tone-mapped PNG");
+    app.add_option("--out-exr", outExr, "linear HDR RGBA EXR");
+    app.add_option("--dirs", dirs, "direction buffer EXR: world exit direction, coverage in A");
+    app.add_option("--dump-shaders", dumpDir, "write the generated GLSL into DIR");
+    CLI11_PARSE(app, argc, argv);
+
+    try {
+        int width = 0, height = 0;
+        char x = 0;
+        std::istringstream sizeStream(size);
+        if (!(sizeStream >> width >> x >> height) || x != 'x' || width < 1 || height < 1 ||
+            width > 16384 || height > 16384 || !sizeStream.eof())
+            throw std::invalid_argument("--size: expected WxH, got '" + size + "'");
+        shrefract::Camera cam = shrefract::Camera::orbit(30.0f, 20.0f, 3.0f);
+        if (!camera.empty()) {
+            if (camera.rfind("orbit:", 0) != 0)
+                throw std::invalid_argument("--camera: expected orbit:AZ,EL,DIST, got '" + camera + "'");
+            auto v = parseFloats(camera.substr(6), 3, "--camera");
+            cam = shrefract::Camera::orbit(v[0], v[1], v[2]);
+        }
+        if (!eye.empty() || !target.empty()) {
+            if (eye.empty() || target.empty() || !camera.empty())
+                throw std::invalid_argument("--eye and --target go together, without --camera");
+            auto e = parseFloats(eye, 3, "--eye"), t = parseFloats(target, 3, "--target");
+            cam.eye = {e[0], e[1], e[2]};
+            cam.target = {t[0], t[1], t[2]};
+        }
+        cam.fovDegrees = fov;
+        shrefract::Backend be = shrefract::parseBackend(backend);
+
+        // Input first (cheap, and the common failure), then the context.
+        shrefract::Bake bake = shrefract::loadBake(bakePath);
+        auto context = shrefract::createHeadlessContext(be, width, height);
+        std::printf("GL: %s (%s)\n", context->description().c_str(), shrefract::ToString(be));
+        shrefract::Environment env = shrefract::Environment::loadLatLong(envPath);
+
+        shrefract::RefractorOptions options;
+        options.preset = preset;
+        options.order = order;
+        options.smoothing = smoothing;
+        options.loader = context->loader();
+        auto refractor = shrefract::Refractor::create(bake, options);
+        std::printf("bake: order %d, %d samples, %d triangles, rho %dx%d; using order %d, %d "
+                    "decompression pass(es), preset %s\n",
+                    bake.order(), bake.sampleCount(), bake.triangleCount(),
+                    refractor->refractionMapSize().x, refractor->refractionMapSize().y,
+                    refractor->order(), refractor->passCount(), preset.c_str());
+        if (!dumpDir.empty()) refractor->dumpShaders(dumpDir);
+
+        // A first frame warms up shader compilation (llvmpipe JIT-compiles at first draw); the
+        // timings printed are the per-stage medians of the `frames` frames after it.
+        shrefract::renderFrame(*refractor, env, cam, width, height);
+        shrefract::RenderedFrame frame;
+        std::vector<shrefract::Timings> all;
+        for (int f = 0; f < std::max(1, frames); ++f) {
+            frame = shrefract::renderFrame(*refractor, env, cam, width, height);
+            all.push_back(frame.timings);
+        }
+        auto median = [&](double shrefract::Timings::*field) {
+            std::vector<double> v;
+            for (const auto& x : all) v.push_back(x.*field);
+            std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+            return v[v.size() / 2];
+        };
+        shrefract::Timings t = frame.timings;
+        t.view = median(&shrefract::Timings::view);
+        t.decompress = median(&shrefract::Timings::decompress);
+        t.smooth = median(&shrefract::Timings::smooth);
+        t.unpack = median(&shrefract::Timings::unpack);
+        t.shade = median(&shrefract::Timings::shade);
+        std::printf("frames: %d timed (median per stage)\n", static_cast<int>(all.size()));
+        std::printf("GPU ms: view %.3f, decompress %.3f (%d passes), smooth %.3f, unpack %.3f, "
+                    "shade %.3f\n",
+                    t.view, t.decompress, t.passes, t.smooth, t.unpack, t.shade);
+        size_t covered = 0;
+        for (size_t i = 3; i < frame.directions.size(); i += 4) covered += frame.directions[i] > 0;
+        std::printf("coverage: %.1f%% of pixels\n", 100.0 * covered / (size_t(width) * height));
+        if (!out.empty()) shrefract::writePng(out, frame, exposure);
+        if (!outExr.empty()) shrefract::writeExr(outExr, width, height, frame.color);
+        if (!dirs.empty()) shrefract::writeExr(dirs, width, height, frame.directions);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "shrefract-render: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}

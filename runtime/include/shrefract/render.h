@@ -1,0 +1,38 @@
+// Offscreen rendering of a bake for tools and tests: the library behind shrefract-render.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "shrefract/runtime.h"
+
+namespace shrefract {
+
+struct Camera {
+    glm::vec3 eye{0, 0, 3}, target{0, 0, 0}, up{0, 1, 0};
+    float fovDegrees = 45.0f;
+    // "AZ,EL,DIST" in degrees and object units around `target`; throws std::invalid_argument.
+    static Camera orbit(float azimuthDeg, float elevationDeg, float distance,
+                        glm::vec3 target = glm::vec3(0.0f));
+};
+
+// One rendered frame: RGBA floats row-major, row 0 = top.
+struct RenderedFrame {
+    int width = 0, height = 0;
+    std::vector<float> color;       // linear HDR radiance, background included, A = 1
+    std::vector<float> directions;  // world exit direction (xyz) + coverage (w) per pixel
+    Timings timings;
+};
+
+// Renders one frame in the current context (object at the origin, identity model).
+RenderedFrame renderFrame(Refractor& refractor, const Environment& environment, const Camera& camera,
+                  int width, int height);
+
+// Writes 8-bit sRGB PNG of toneMap(color), or float RGBA EXR; throws std::runtime_error naming
+// the file. Both write to a temporary name and rename, so a failure leaves no file.
+void writePng(const std::string& path, const RenderedFrame& frame, float exposure = 1.0f);
+void writeExr(const std::string& path, int width, int height, const std::vector<float>& rgba);
+
+}  // namespace shrefract

@@ -1,0 +1,118 @@
+// The shrefract runtime: decompresses a bake's SH weights for the current viewpoint on the GPU,
+// builds the seamless refraction map and shades the glass object (paper §5, DESIGN.md §4).
+// Every GL entry point uses the caller's current OpenGL 3.3+ core context.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace shrefract {
+
+struct BakeData;  // common/bakefile.h
+
+// A loaded bake, cheap to copy (shared, immutable).
+class Bake {
+public:
+    int order() const;          // L stored
+    int sampleCount() const;    // |O_d|
+    int triangleCount() const;
+    float ior() const;          // manifest media[0].ior, else 1.5
+    glm::vec3 absorption() const;  // manifest media[0].absorption (kappa per RGB), else 0
+    const BakeData& data() const;
+
+private:
+    friend Bake makeBake(BakeData data);
+    std::shared_ptr<const BakeData> data_;
+};
+
+// Reads NAME.shrefract.exr; throws InputError naming the file (missing, corrupt, newer format).
+Bake loadBake(const std::string& path);
+// Wraps bake data already in memory (tests, tools that bake and render in one process).
+Bake makeBake(BakeData data);
+
+// An HDR environment as a GL cube map (RGB16F... RGB32F, linear filtering, seamless).
+// Lat-long convention: +y up; u = 0.5 + atan2(d.x, -d.z) / 2pi, v = acos(d.y) / pi (row 0 top).
+class Environment {
+public:
+    // Loads a lat-long EXR into a cube map of `faceSize` (0: height / 2); throws InputError.
+    static Environment loadLatLong(const std::string& path, int faceSize = 0);
+    // Builds the cube map from lat-long RGB floats, row-major, row 0 = top (+y).
+    static Environment fromLatLong(int width, int height, const std::vector<float>& rgb,
+                                   int faceSize = 0);
+    Environment(Environment&&) noexcept;
+    Environment& operator=(Environment&&) noexcept;
+    ~Environment();
+    unsigned cubeMap() const { return texture_; }  // GL_TEXTURE_CUBE_MAP name
+    int faceSize() const { return faceSize_; }
+    // Draws the environment behind everything (depth test LEQUAL at the far plane).
+    void drawBackground(const glm::mat4& view, const glm::mat4& projection) const;
+
+private:
+    Environment() = default;
+    unsigned texture_ = 0, program_ = 0, vao_ = 0;
+    int faceSize_ = 0;
+};
+
+// HDR to display, documented once (docs/runtime.md): c * exposure, then the ACES filmic fit of
+// Narkowicz 2015, clamped to [0, 1], then the sRGB transfer function.
+glm::vec3 toneMap(glm::vec3 hdr, float exposure = 1.0f);
+
+// GPU time per stage of the last update()/draw(), milliseconds (GL timer queries).
+struct Timings {
+    double view = 0;        // eye -> local view direction per sample
+    double decompress = 0;  // D_mu, all generated passes
+    double smooth = 0;      // neighbour-list smoothing (0 when off)
+    double unpack = 0;      // mu -> rho with correction texels
+    double shade = 0;       // draw()
+    int passes = 0;         // decompression passes used
+};
+
+struct RefractorOptions {
+    std::string preset = "modern";  // shader limits: "modern" or "2006" (runtime/src/shadergen.h)
+    int order = -1;                 // SH order used, -1: all stored
+    bool smoothing = false;         // spatial smoothing through the bake's neighbour lists
+    bool correction = true;         // interpolation-correction texels in rho (paper §5.3.1)
+    bool timings = true;            // GL timer queries around every stage
+    bool toneMap = false;           // draw() writes display values (toneMap()) instead of HDR
+    float exposure = 1.0f;
+    void* (*loader)(const char*) = nullptr;  // GL function loader; nullptr: guess from context
+};
+
+class Refractor {
+public:
+    // Uploads the bake and compiles the shaders in the current context; throws on GL failure.
+    static std::unique_ptr<Refractor> create(const Bake& bake, const RefractorOptions& options = {});
+    ~Refractor();
+    // Builds the refraction map for a viewer at `eye` (world space), object placed by `model`.
+    void update(glm::vec3 eye, const glm::mat4& model = glm::mat4(1.0f));
+    // Shades the object into the bound framebuffer: colour to draw buffer 0 (linear HDR unless
+    // toneMap), world exit direction + coverage 1 to draw buffer 1 when one is bound.
+    void draw(const glm::mat4& view, const glm::mat4& projection, const glm::mat4& model,
+              const Environment& environment);
+    unsigned refractionMap() const;     // GL_TEXTURE_2D, RGBA32F rho layout, GL_LINEAR
+    glm::ivec2 refractionMapSize() const;
+    // Progressive decompression (paper §6): use bands 0..L, L <= bake order (clamped).
+    void setOrder(int L);
+    int order() const;
+    void setSmoothing(bool on);
+    void setCorrection(bool on);  // off only to show the seams it removes
+    const Timings& timings() const;
+    int passCount() const;  // decompression passes at the current order
+    // Writes the generated GLSL of the current order into `dir`.
+    void dumpShaders(const std::string& dir) const;
+    // Reads back D_mu after update() (smoothed if on): 4 floats per sample, sample order.
+    std::vector<float> readDirectionalMap() const;
+    // Reads back the refraction map, rho layout, RGBA row-major from row 0.
+    std::vector<float> readRefractionMap() const;
+
+    struct Impl;
+
+private:
+    explicit Refractor(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace shrefract

@@ -1,0 +1,46 @@
+#include "common/bakefile.h"
+#include "common/error.h"
+#include "shrefract/runtime.h"
+
+namespace shrefract {
+
+Bake loadBake(const std::string& path) { return makeBake(readBake(path)); }
+
+Bake makeBake(BakeData data) {
+    Bake b;
+    b.data_ = std::make_shared<const BakeData>(std::move(data));
+    return b;
+}
+
+const BakeData& Bake::data() const {
+    SHREFRACT_CHECK(data_ != nullptr);
+    return *data_;
+}
+int Bake::order() const { return data().order; }
+int Bake::sampleCount() const { return data().layout.sampleCount(); }
+int Bake::triangleCount() const { return data().layout.triangleCount; }
+
+// The first medium of the manifest is the object's (docs/format.md "media").
+static const nlohmann::json* firstMedium(const BakeData& d) {
+    const auto& m = d.manifest;
+    if (!m.is_object() || !m.contains("media") || !m["media"].is_array() || m["media"].empty())
+        return nullptr;
+    return &m["media"][0];
+}
+
+float Bake::ior() const {
+    const nlohmann::json* m = firstMedium(data());
+    if (m && m->contains("ior") && (*m)["ior"].is_number()) return (*m)["ior"].get<float>();
+    return 1.5f;
+}
+
+glm::vec3 Bake::absorption() const {
+    const nlohmann::json* m = firstMedium(data());
+    if (m && m->contains("absorption") && (*m)["absorption"].is_array() &&
+        (*m)["absorption"].size() == 3)
+        return {(*m)["absorption"][0].get<float>(), (*m)["absorption"][1].get<float>(),
+                (*m)["absorption"][2].get<float>()};
+    return glm::vec3(0.0f);
+}
+
+}  // namespace shrefract

@@ -1,0 +1,195 @@
+// The two headless backends. EGL headers stay in this file; GL calls go through gl.h.
+#define EGL_NO_X11
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#include <dlfcn.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "gl.h"
+#include "shrefract/context.h"
+
+// From GL/osmesa.h, which pulls in GL/gl.h (prototypes we must not see): the few tokens used.
+#define OSMESA_RGBA 0x1908
+#define OSMESA_FORMAT 0x22
+#define OSMESA_CONTEXT_MAJOR_VERSION 0x36
+#define OSMESA_CONTEXT_MINOR_VERSION 0x37
+#define OSMESA_PROFILE 0x33
+#define OSMESA_CORE_PROFILE 0x34
+#define OSMESA_DEPTH_BITS 0x30
+
+namespace shrefract {
+
+namespace {
+
+// libOSMesa, opened RTLD_LOCAL at first use so its exported gl* symbols never shadow the
+// application's libGL/libOpenGL.
+struct OSMesaLib {
+    using Context = void*;
+    Context (*createContextAttribs)(const int*, Context) = nullptr;
+    unsigned char (*makeCurrent)(Context, void*, unsigned, int, int) = nullptr;
+    void (*destroyContext)(Context) = nullptr;
+    Context (*getCurrentContext)() = nullptr;
+    void* (*getProcAddress)(const char*) = nullptr;
+    void* handle = nullptr;
+    std::string error;
+
+    static OSMesaLib& get(bool load) {
+        static OSMesaLib lib;
+        if (lib.handle || !load) return lib;
+        for (const char* name : {"libOSMesa.so.8", "libOSMesa.so.6", "libOSMesa.so"}) {
+            lib.handle = dlopen(name, RTLD_NOW | RTLD_LOCAL);
+            if (lib.handle) break;
+        }
+        if (!lib.handle) {
+            lib.error = "libOSMesa not found (install libosmesa6; removed from Mesa >= 25.1)";
+            return lib;
+        }
+        lib.createContextAttribs = reinterpret_cast<decltype(lib.createContextAttribs)>(
+            dlsym(lib.handle, "OSMesaCreateContextAttribs"));
+        lib.makeCurrent =
+            reinterpret_cast<decltype(lib.makeCurrent)>(dlsym(lib.handle, "OSMesaMakeCurrent"));
+        lib.destroyContext = reinterpret_cast<decltype(lib.destroyContext)>(
+            dlsym(lib.handle, "OSMesaDestroyContext"));
+        lib.getCurrentContext = reinterpret_cast<decltype(lib.getCurrentContext)>(
+            dlsym(lib.handle, "OSMesaGetCurrentContext"));
+        lib.getProcAddress = reinterpret_cast<decltype(lib.getProcAddress)>(
+            dlsym(lib.handle, "OSMesaGetProcAddress"));
+        if (!lib.createContextAttribs || !lib.makeCurrent || !lib.destroyContext ||
+            !lib.getCurrentContext || !lib.getProcAddress)
+            lib.error = "libOSMesa lacks OSMesaCreateContextAttribs (too old)";
+        return lib;
+    }
+};
+
+void* osmesaLoader(const char* name) { return OSMesaLib::get(true).getProcAddress(name); }
+void* eglLoader(const char* name) { return reinterpret_cast<void*>(eglGetProcAddress(name)); }
+
+std::string describeCurrent(gl::Loader loader) {
+    gl::ensureLoaded(loader);
+    auto s = [](GLenum e) {
+        const GLubyte* v = gl::glGetString(e);
+        return v ? std::string(reinterpret_cast<const char*>(v)) : std::string("?");
+    };
+    return s(GL_RENDERER) + ", " + s(GL_VERSION);
+}
+
+class EglContext final : public HeadlessContext {
+public:
+    EglContext() {
+        auto getPlatformDisplay = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
+            eglGetProcAddress("eglGetPlatformDisplayEXT"));
+        if (!getPlatformDisplay)
+            throw ContextError("EGL: eglGetPlatformDisplayEXT unavailable (no EGL_EXT_platform_base)");
+        display_ = getPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+        EGLint major = 0, minor = 0;
+        if (display_ == EGL_NO_DISPLAY || !eglInitialize(display_, &major, &minor))
+            throw ContextError("EGL: no surfaceless display (needs Mesa's "
+                               "EGL_MESA_platform_surfaceless); error 0x" + hex(eglGetError()));
+        if (!eglBindAPI(EGL_OPENGL_API)) {
+            eglTerminate(display_);
+            throw ContextError("EGL: desktop OpenGL API not available");
+        }
+        for (int version : {45, 33}) {
+            EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION, version / 10,
+                                EGL_CONTEXT_MINOR_VERSION, version % 10,
+                                EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                                EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+            context_ = eglCreateContext(display_, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attribs);
+            if (context_ != EGL_NO_CONTEXT) break;
+        }
+        if (context_ == EGL_NO_CONTEXT) {
+            EGLint e = eglGetError();
+            eglTerminate(display_);
+            throw ContextError("EGL: cannot create a 3.3 core context without config "
+                               "(EGL_KHR_no_config_context); error 0x" + hex(e));
+        }
+        makeCurrent();
+    }
+    ~EglContext() override {
+        eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+        eglDestroyContext(display_, context_);
+        // The display is shared process-wide by Mesa; terminating it would kill other contexts.
+    }
+    void makeCurrent() override {
+        if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_))
+            throw ContextError("EGL: eglMakeCurrent failed (EGL_KHR_surfaceless_context?)");
+    }
+    Backend backend() const override { return Backend::Egl; }
+    void* (*loader() const)(const char*) override { return &eglLoader; }
+    std::string description() const override { return describeCurrent(&eglLoader); }
+
+private:
+    static std::string hex(EGLint v) {
+        char b[16];
+        std::snprintf(b, sizeof b, "%04x", static_cast<unsigned>(v));
+        return b;
+    }
+    EGLDisplay display_ = EGL_NO_DISPLAY;
+    EGLContext context_ = EGL_NO_CONTEXT;
+};
+
+class OSMesaContext final : public HeadlessContext {
+public:
+    OSMesaContext(int width, int height)
+        : width_(std::max(1, width)), height_(std::max(1, height)),
+          buffer_(static_cast<size_t>(width_) * height_) {
+        OSMesaLib& lib = OSMesaLib::get(true);
+        if (!lib.error.empty()) throw ContextError("OSMesa: " + lib.error);
+        for (int version : {45, 33}) {
+            int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 24,
+                             OSMESA_PROFILE, OSMESA_CORE_PROFILE,
+                             OSMESA_CONTEXT_MAJOR_VERSION, version / 10,
+                             OSMESA_CONTEXT_MINOR_VERSION, version % 10, 0};
+            context_ = lib.createContextAttribs(attribs, nullptr);
+            if (context_) break;
+        }
+        if (!context_) throw ContextError("OSMesa: cannot create a 3.3 core profile context");
+        makeCurrent();
+    }
+    ~OSMesaContext() override {
+        OSMesaLib& lib = OSMesaLib::get(false);
+        // Release first, so that OSMesaGetCurrentContext() no longer names a dead context.
+        if (lib.getCurrentContext() == context_) lib.makeCurrent(nullptr, nullptr, 0, 0, 0);
+        lib.destroyContext(context_);
+    }
+    void makeCurrent() override {
+        if (!OSMesaLib::get(false).makeCurrent(context_, buffer_.data(), GL_UNSIGNED_BYTE,
+                                               width_, height_))
+            throw ContextError("OSMesa: OSMesaMakeCurrent failed");
+    }
+    Backend backend() const override { return Backend::OSMesa; }
+    void* (*loader() const)(const char*) override { return &osmesaLoader; }
+    std::string description() const override { return describeCurrent(&osmesaLoader); }
+
+private:
+    int width_, height_;
+    std::vector<uint32_t> buffer_;
+    void* context_ = nullptr;
+};
+
+}  // namespace
+
+std::unique_ptr<HeadlessContext> createHeadlessContext(Backend backend, int width, int height) {
+    if (backend == Backend::OSMesa) return std::make_unique<OSMesaContext>(width, height);
+    return std::make_unique<EglContext>();
+}
+
+Backend parseBackend(const std::string& text) {
+    if (text == "egl") return Backend::Egl;
+    if (text == "osmesa") return Backend::OSMesa;
+    throw std::invalid_argument("unknown GL backend '" + text + "' (egl | osmesa)");
+}
+
+const char* ToString(Backend backend) { return backend == Backend::Egl ? "egl" : "osmesa"; }
+
+namespace gl {
+Loader currentContextLoader() {
+    OSMesaLib& lib = OSMesaLib::get(false);
+    if (lib.handle && lib.getCurrentContext && lib.getCurrentContext()) return &osmesaLoader;
+    return &eglLoader;
+}
+}  // namespace gl
+
+}  // namespace shrefract

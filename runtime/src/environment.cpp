@@ -1,0 +1,162 @@
+// Lat-long EXR -> GL cube map, and the background pass.
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <ImfArray.h>
+#include <ImfRgbaFile.h>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "common/error.h"
+#include "gl.h"
+#include "glsl.h"
+#include "shrefract/runtime.h"
+
+namespace shrefract {
+
+using namespace gl;
+
+namespace {
+
+// Bilinear lookup in the lat-long image at direction d (convention in runtime.h).
+glm::vec3 sampleLatLong(int w, int h, const std::vector<float>& rgb, glm::vec3 d) {
+    float u = 0.5f + std::atan2(d.x, -d.z) / (2.0f * float(M_PI));
+    float v = std::acos(std::clamp(d.y, -1.0f, 1.0f)) / float(M_PI);
+    float x = u * w - 0.5f, y = std::clamp(v * h - 0.5f, 0.0f, float(h - 1));
+    int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+    float fx = x - x0, fy = y - y0;
+    auto at = [&](int xi, int yi) {
+        xi = ((xi % w) + w) % w;
+        yi = std::clamp(yi, 0, h - 1);
+        const float* p = &rgb[(static_cast<size_t>(yi) * w + xi) * 3];
+        return glm::vec3(p[0], p[1], p[2]);
+    };
+    return (1 - fx) * (1 - fy) * at(x0, y0) + fx * (1 - fy) * at(x0 + 1, y0) +
+           (1 - fx) * fy * at(x0, y0 + 1) + fx * fy * at(x0 + 1, y0 + 1);
+}
+
+// Direction through (s, t) in [-1, 1]^2 of cube face f, OpenGL's face orientation table.
+glm::vec3 faceDirection(int f, float s, float t) {
+    switch (f) {
+        case 0: return {1, -t, -s};
+        case 1: return {-1, -t, s};
+        case 2: return {s, 1, t};
+        case 3: return {s, -1, -t};
+        case 4: return {s, -t, 1};
+        default: return {-s, -t, -1};
+    }
+}
+
+}  // namespace
+
+Environment Environment::loadLatLong(const std::string& path, int faceSize) {
+    std::vector<float> rgb;
+    int w = 0, h = 0;
+    try {
+        Imf::RgbaInputFile file(path.c_str());
+        Imath::Box2i dw = file.dataWindow();
+        w = dw.max.x - dw.min.x + 1;
+        h = dw.max.y - dw.min.y + 1;
+        Imf::Array2D<Imf::Rgba> pixels(h, w);
+        file.setFrameBuffer(&pixels[0][0] - dw.min.x - dw.min.y * w, 1, w);
+        file.readPixels(dw.min.y, dw.max.y);
+        rgb.resize(static_cast<size_t>(w) * h * 3);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const Imf::Rgba& p = pixels[y][x];
+                float* o = &rgb[(static_cast<size_t>(y) * w + x) * 3];
+                o[0] = p.r;
+                o[1] = p.g;
+                o[2] = p.b;
+            }
+    } catch (const std::exception& e) {
+        throw inputError(path, std::string("cannot read environment EXR: ") + e.what());
+    }
+    if (w < 2 || h < 1) throw inputError(path, "environment image is empty");
+    return fromLatLong(w, h, rgb, faceSize);
+}
+
+Environment Environment::fromLatLong(int width, int height, const std::vector<float>& rgb,
+                                     int faceSize) {
+    if (width < 1 || height < 1 || rgb.size() != static_cast<size_t>(width) * height * 3)
+        throw std::invalid_argument("shrefract: lat-long image size mismatch");
+    ensureLoaded(currentContextLoader());
+    Environment env;
+    env.faceSize_ = faceSize > 0 ? faceSize : std::max(1, height / 2);
+    const int n = env.faceSize_;
+    glGenTextures(1, &env.texture_);
+    glBindTexture(GL_TEXTURE_CUBE_MAP, env.texture_);
+    std::vector<float> face(static_cast<size_t>(n) * n * 3);
+    for (int f = 0; f < 6; ++f) {
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x) {
+                glm::vec3 d = glm::normalize(
+                    faceDirection(f, 2.0f * (x + 0.5f) / n - 1.0f, 2.0f * (y + 0.5f) / n - 1.0f));
+                glm::vec3 c = sampleLatLong(width, height, rgb, d);
+                float* o = &face[(static_cast<size_t>(y) * n + x) * 3];
+                o[0] = c.r;
+                o[1] = c.g;
+                o[2] = c.b;
+            }
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, 0, GL_RGB32F, n, n, 0, GL_RGB, GL_FLOAT,
+                     face.data());
+    }
+    glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
+        glTexParameteri(GL_TEXTURE_CUBE_MAP, wrap, GL_CLAMP_TO_EDGE);
+    glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
+    env.program_ = buildProgram(glsl::kFullscreenVertex, glsl::kBackgroundFragment, "background");
+    glGenVertexArrays(1, &env.vao_);
+    return env;
+}
+
+Environment::Environment(Environment&& o) noexcept { *this = std::move(o); }
+
+Environment& Environment::operator=(Environment&& o) noexcept {
+    std::swap(texture_, o.texture_);
+    std::swap(program_, o.program_);
+    std::swap(vao_, o.vao_);
+    std::swap(faceSize_, o.faceSize_);
+    return *this;
+}
+
+Environment::~Environment() {
+    if (!texture_) return;
+    try {
+        ensureLoaded(currentContextLoader());
+    } catch (...) {
+        return;
+    }
+    glDeleteTextures(1, &texture_);
+    glDeleteProgram(program_);
+    glDeleteVertexArrays(1, &vao_);
+}
+
+void Environment::drawBackground(const glm::mat4& view, const glm::mat4& projection) const {
+    ensureLoaded(currentContextLoader());
+    GLint viewport[4];
+    glGetIntegerv(GL_VIEWPORT, viewport);
+    glm::mat4 rotationOnly = glm::mat4(glm::mat3(view));
+    glm::mat4 inverse = glm::inverse(projection * rotationOnly);
+    glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_FALSE);
+    glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
+    glUseProgram(program_);
+    glUniform1i(glGetUniformLocation(program_, "uEnvironment"), 0);
+    glUniformMatrix4fv(glGetUniformLocation(program_, "uInverseViewProjection"), 1, GL_FALSE,
+                       glm::value_ptr(inverse));
+    glUniform2f(glGetUniformLocation(program_, "uViewport"), float(viewport[2]), float(viewport[3]));
+    glUniform2f(glGetUniformLocation(program_, "uViewportOrigin"), float(viewport[0]),
+                float(viewport[1]));
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_CUBE_MAP, texture_);
+    glBindVertexArray(vao_);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindVertexArray(0);
+    glUseProgram(0);
+    glDepthMask(GL_TRUE);
+}
+
+}  // namespace shrefract

@@ -1,0 +1,84 @@
+#include "gl.h"
+
+#include <cstdio>
+#include <stdexcept>
+#include <vector>
+
+namespace shrefract::gl {
+
+#define SHREFRACT_GL_DEFINE(type, name) type name = nullptr;
+SHREFRACT_GL_FUNCTIONS(SHREFRACT_GL_DEFINE)
+#undef SHREFRACT_GL_DEFINE
+
+namespace {
+Loader g_loaded = nullptr;
+}
+
+void ensureLoaded(Loader loader) {
+    if (!loader) throw std::runtime_error("shrefract: no OpenGL loader (is a context current?)");
+    if (loader == g_loaded) return;
+#define SHREFRACT_GL_LOAD(type, name)                                                     \
+    name = reinterpret_cast<type>(loader(#name));                                         \
+    if (!name) throw std::runtime_error("shrefract: OpenGL function " #name " not found");
+    SHREFRACT_GL_FUNCTIONS(SHREFRACT_GL_LOAD)
+#undef SHREFRACT_GL_LOAD
+    g_loaded = loader;
+}
+
+static GLuint compile(GLenum stage, const std::string& source, const std::string& what) {
+    GLuint s = glCreateShader(stage);
+    const char* text = source.c_str();
+    glShaderSource(s, 1, &text, nullptr);
+    glCompileShader(s);
+    GLint ok = 0;
+    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        GLint n = 0;
+        glGetShaderiv(s, GL_INFO_LOG_LENGTH, &n);
+        std::vector<char> log(n + 1, '\0');
+        glGetShaderInfoLog(s, n, nullptr, log.data());
+        glDeleteShader(s);
+        throw std::runtime_error("shrefract: compiling " + what + " (" +
+                                 (stage == GL_VERTEX_SHADER ? "vertex" : "fragment") +
+                                 "): " + log.data());
+    }
+    return s;
+}
+
+GLuint buildProgram(const std::string& vertex, const std::string& fragment,
+                    const std::string& what) {
+    GLuint vs = compile(GL_VERTEX_SHADER, vertex, what);
+    GLuint fs = 0;
+    try {
+        fs = compile(GL_FRAGMENT_SHADER, fragment, what);
+    } catch (...) {
+        glDeleteShader(vs);
+        throw;
+    }
+    GLuint p = glCreateProgram();
+    glAttachShader(p, vs);
+    glAttachShader(p, fs);
+    glLinkProgram(p);
+    glDeleteShader(vs);
+    glDeleteShader(fs);
+    GLint ok = 0;
+    glGetProgramiv(p, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        GLint n = 0;
+        glGetProgramiv(p, GL_INFO_LOG_LENGTH, &n);
+        std::vector<char> log(n + 1, '\0');
+        glGetProgramInfoLog(p, n, nullptr, log.data());
+        glDeleteProgram(p);
+        throw std::runtime_error("shrefract: linking " + what + ": " + log.data());
+    }
+    return p;
+}
+
+#ifndef NDEBUG
+void checkGlError(const char* file, int line) {
+    GLenum e = glGetError();
+    if (e != GL_NO_ERROR) std::fprintf(stderr, "shrefract: GL error 0x%04x at %s:%d\n", e, file, line);
+}
+#endif
+
+}  // namespace shrefract::gl

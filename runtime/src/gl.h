@@ -1,0 +1,114 @@
+// A tiny OpenGL function-pointer loader: the core 3.3 functions the runtime calls, resolved
+// through the caller's getProcAddress (eglGetProcAddress, OSMesaGetProcAddress, glfw...).
+//
+// Why not link libOpenGL.so: an OSMesa context is not reachable through GLVND's dispatch, so
+// the same binary could not drive both headless backends. Loading pointers works for both.
+// Include this header instead of any GL header; it declares no prototypes.
+#pragma once
+
+#include <GL/glcorearb.h>
+
+#include <string>
+
+namespace shrefract::gl {
+
+// Resolves one GL entry point by name in the current context; nullptr if unknown.
+using Loader = void* (*)(const char* name);
+
+// The function list: X(type, name).
+#define SHREFRACT_GL_FUNCTIONS(X)                                          \
+    X(PFNGLGETERRORPROC, glGetError)                                       \
+    X(PFNGLGETSTRINGPROC, glGetString)                                     \
+    X(PFNGLGETINTEGERVPROC, glGetIntegerv)                                 \
+    X(PFNGLENABLEPROC, glEnable)                                           \
+    X(PFNGLDISABLEPROC, glDisable)                                         \
+    X(PFNGLVIEWPORTPROC, glViewport)                                       \
+    X(PFNGLCLEARPROC, glClear)                                             \
+    X(PFNGLCLEARCOLORPROC, glClearColor)                                   \
+    X(PFNGLDEPTHFUNCPROC, glDepthFunc)                                     \
+    X(PFNGLDEPTHMASKPROC, glDepthMask)                                     \
+    X(PFNGLPIXELSTOREIPROC, glPixelStorei)                                 \
+    X(PFNGLREADPIXELSPROC, glReadPixels)                                   \
+    X(PFNGLREADBUFFERPROC, glReadBuffer)                                   \
+    X(PFNGLFINISHPROC, glFinish)                                           \
+    X(PFNGLGENTEXTURESPROC, glGenTextures)                                 \
+    X(PFNGLDELETETEXTURESPROC, glDeleteTextures)                           \
+    X(PFNGLBINDTEXTUREPROC, glBindTexture)                                 \
+    X(PFNGLACTIVETEXTUREPROC, glActiveTexture)                             \
+    X(PFNGLTEXIMAGE2DPROC, glTexImage2D)                                   \
+    X(PFNGLTEXIMAGE3DPROC, glTexImage3D)                                   \
+    X(PFNGLTEXSUBIMAGE3DPROC, glTexSubImage3D)                             \
+    X(PFNGLTEXPARAMETERIPROC, glTexParameteri)                             \
+    X(PFNGLGETTEXIMAGEPROC, glGetTexImage)                                 \
+    X(PFNGLGENFRAMEBUFFERSPROC, glGenFramebuffers)                         \
+    X(PFNGLDELETEFRAMEBUFFERSPROC, glDeleteFramebuffers)                   \
+    X(PFNGLBINDFRAMEBUFFERPROC, glBindFramebuffer)                         \
+    X(PFNGLFRAMEBUFFERTEXTURE2DPROC, glFramebufferTexture2D)               \
+    X(PFNGLFRAMEBUFFERRENDERBUFFERPROC, glFramebufferRenderbuffer)         \
+    X(PFNGLCHECKFRAMEBUFFERSTATUSPROC, glCheckFramebufferStatus)           \
+    X(PFNGLDRAWBUFFERSPROC, glDrawBuffers)                                 \
+    X(PFNGLGENRENDERBUFFERSPROC, glGenRenderbuffers)                       \
+    X(PFNGLDELETERENDERBUFFERSPROC, glDeleteRenderbuffers)                 \
+    X(PFNGLBINDRENDERBUFFERPROC, glBindRenderbuffer)                       \
+    X(PFNGLRENDERBUFFERSTORAGEPROC, glRenderbufferStorage)                 \
+    X(PFNGLCREATESHADERPROC, glCreateShader)                               \
+    X(PFNGLSHADERSOURCEPROC, glShaderSource)                               \
+    X(PFNGLCOMPILESHADERPROC, glCompileShader)                             \
+    X(PFNGLGETSHADERIVPROC, glGetShaderiv)                                 \
+    X(PFNGLGETSHADERINFOLOGPROC, glGetShaderInfoLog)                       \
+    X(PFNGLDELETESHADERPROC, glDeleteShader)                               \
+    X(PFNGLCREATEPROGRAMPROC, glCreateProgram)                             \
+    X(PFNGLATTACHSHADERPROC, glAttachShader)                               \
+    X(PFNGLLINKPROGRAMPROC, glLinkProgram)                                 \
+    X(PFNGLGETPROGRAMIVPROC, glGetProgramiv)                               \
+    X(PFNGLGETPROGRAMINFOLOGPROC, glGetProgramInfoLog)                     \
+    X(PFNGLDELETEPROGRAMPROC, glDeleteProgram)                             \
+    X(PFNGLUSEPROGRAMPROC, glUseProgram)                                   \
+    X(PFNGLGETUNIFORMLOCATIONPROC, glGetUniformLocation)                   \
+    X(PFNGLUNIFORM1IPROC, glUniform1i)                                     \
+    X(PFNGLUNIFORM1FPROC, glUniform1f)                                     \
+    X(PFNGLUNIFORM2FPROC, glUniform2f)                                     \
+    X(PFNGLUNIFORM3FPROC, glUniform3f)                                     \
+    X(PFNGLUNIFORMMATRIX3FVPROC, glUniformMatrix3fv)                       \
+    X(PFNGLUNIFORMMATRIX4FVPROC, glUniformMatrix4fv)                       \
+    X(PFNGLBINDFRAGDATALOCATIONPROC, glBindFragDataLocation)               \
+    X(PFNGLBINDATTRIBLOCATIONPROC, glBindAttribLocation)                   \
+    X(PFNGLGENVERTEXARRAYSPROC, glGenVertexArrays)                         \
+    X(PFNGLDELETEVERTEXARRAYSPROC, glDeleteVertexArrays)                   \
+    X(PFNGLBINDVERTEXARRAYPROC, glBindVertexArray)                         \
+    X(PFNGLGENBUFFERSPROC, glGenBuffers)                                   \
+    X(PFNGLDELETEBUFFERSPROC, glDeleteBuffers)                             \
+    X(PFNGLBINDBUFFERPROC, glBindBuffer)                                   \
+    X(PFNGLBUFFERDATAPROC, glBufferData)                                   \
+    X(PFNGLENABLEVERTEXATTRIBARRAYPROC, glEnableVertexAttribArray)         \
+    X(PFNGLVERTEXATTRIBPOINTERPROC, glVertexAttribPointer)                 \
+    X(PFNGLDRAWARRAYSPROC, glDrawArrays)                                   \
+    X(PFNGLGENQUERIESPROC, glGenQueries)                                   \
+    X(PFNGLDELETEQUERIESPROC, glDeleteQueries)                             \
+    X(PFNGLBEGINQUERYPROC, glBeginQuery)                                   \
+    X(PFNGLENDQUERYPROC, glEndQuery)                                       \
+    X(PFNGLGETQUERYOBJECTUI64VPROC, glGetQueryObjectui64v)
+
+#define SHREFRACT_GL_DECLARE(type, name) extern type name;
+SHREFRACT_GL_FUNCTIONS(SHREFRACT_GL_DECLARE)
+#undef SHREFRACT_GL_DECLARE
+
+// Resolves every function through `loader` unless it is the loader used last time (cheap to call
+// at each entry point). Throws std::runtime_error naming the first missing function.
+void ensureLoaded(Loader loader);
+// The loader for whatever context is current: OSMesa's if an OSMesa context is current, else
+// eglGetProcAddress (which also serves GLX and EGL contexts under GLVND).
+Loader currentContextLoader();
+
+// Compiles and links a program; throws std::runtime_error with the info log and `what`.
+GLuint buildProgram(const std::string& vertex, const std::string& fragment, const std::string& what);
+
+// GL error check that compiles out of release builds (STYLE.md).
+#ifdef NDEBUG
+#define SHREFRACT_GL_CHECK() ((void)0)
+#else
+void checkGlError(const char* file, int line);
+#define SHREFRACT_GL_CHECK() ::shrefract::gl::checkGlError(__FILE__, __LINE__)
+#endif
+
+}  // namespace shrefract::gl

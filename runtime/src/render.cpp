@@ -1,0 +1,167 @@
+#include "shrefract/render.h"
+
+#include <png.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+
+#include <ImfOutputFile.h>
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "gl.h"
+
+namespace shrefract {
+
+using namespace gl;
+
+Camera Camera::orbit(float azimuthDeg, float elevationDeg, float distance, glm::vec3 target) {
+    if (!(distance > 0.0f)) throw std::invalid_argument("orbit distance must be > 0");
+    float az = glm::radians(azimuthDeg), el = glm::radians(elevationDeg);
+    Camera c;
+    c.target = target;
+    // Azimuth 0 looks from +z toward the target; positive azimuth turns toward +x; y is up.
+    c.eye = target + distance * glm::vec3(std::cos(el) * std::sin(az), std::sin(el),
+                                          std::cos(el) * std::cos(az));
+    return c;
+}
+
+glm::vec3 toneMap(glm::vec3 c, float exposure) {
+    c *= exposure;
+    c = glm::clamp((c * (2.51f * c + 0.03f)) / (c * (2.43f * c + 0.59f) + 0.14f), 0.0f, 1.0f);
+    for (int i = 0; i < 3; ++i)
+        c[i] = c[i] <= 0.0031308f ? 12.92f * c[i] : 1.055f * std::pow(c[i], 1.0f / 2.4f) - 0.055f;
+    return c;
+}
+
+RenderedFrame renderFrame(Refractor& refractor, const Environment& environment,
+                          const Camera& camera, int width, int height) {
+    ensureLoaded(currentContextLoader());
+    RenderedFrame out;
+    out.width = width;
+    out.height = height;
+    // Colour (RGBA32F), direction buffer (RGBA32F) and depth.
+    GLuint textures[2], depth = 0, fbo = 0;
+    glGenTextures(2, textures);
+    for (GLuint t : textures) {
+        glBindTexture(GL_TEXTURE_2D, t);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    }
+    glGenRenderbuffers(1, &depth);
+    glBindRenderbuffer(GL_RENDERBUFFER, depth);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, textures[0], 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, textures[1], 0);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
+    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(2, buffers);
+    bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    if (complete) {
+        glViewport(0, 0, width, height);
+        glClearColor(0, 0, 0, 0);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        glm::mat4 view = glm::lookAt(camera.eye, camera.target, camera.up);
+        glm::mat4 projection = glm::perspective(glm::radians(camera.fovDegrees),
+                                                float(width) / float(height), 0.01f, 1000.0f);
+        glm::mat4 model(1.0f);
+        refractor.update(camera.eye, model);
+        environment.drawBackground(view, projection);
+        refractor.draw(view, projection, model, environment);
+        glFinish();
+        // Read back, flipping GL's bottom-up rows to top-down.
+        std::vector<float> rows(static_cast<size_t>(width) * height * 4);
+        for (int a = 0; a < 2; ++a) {
+            glReadBuffer(buffers[a]);
+            glPixelStorei(GL_PACK_ALIGNMENT, 1);
+            glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, rows.data());
+            std::vector<float>& dst = a == 0 ? out.color : out.directions;
+            dst.resize(rows.size());
+            const size_t stride = static_cast<size_t>(width) * 4;
+            for (int y = 0; y < height; ++y)
+                std::copy_n(&rows[(height - 1 - y) * stride], stride, &dst[y * stride]);
+        }
+        out.timings = refractor.timings();
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glDeleteFramebuffers(1, &fbo);
+    glDeleteRenderbuffers(1, &depth);
+    glDeleteTextures(2, textures);
+    if (!complete) throw std::runtime_error("shrefract: offscreen framebuffer incomplete");
+    return out;
+}
+
+namespace {
+
+// Writes through `write` to PATH.tmp, then renames: a failure leaves no file at `path`.
+template <typename F>
+void writeAtomically(const std::string& path, F write) {
+    std::string tmp = path + ".tmp";
+    try {
+        write(tmp);
+        std::filesystem::rename(tmp, path);
+    } catch (const std::exception& e) {
+        std::error_code ec;
+        std::filesystem::remove(tmp, ec);
+        throw std::runtime_error(path + ": cannot write: " + e.what());
+    }
+}
+
+}  // namespace
+
+void writePng(const std::string& path, const RenderedFrame& frame, float exposure) {
+    const int w = frame.width, h = frame.height;
+    std::vector<unsigned char> pixels(static_cast<size_t>(w) * h * 3);
+    for (size_t i = 0; i < static_cast<size_t>(w) * h; ++i) {
+        glm::vec3 c = toneMap({frame.color[4 * i], frame.color[4 * i + 1], frame.color[4 * i + 2]},
+                              exposure);
+        for (int k = 0; k < 3; ++k)
+            pixels[3 * i + k] = static_cast<unsigned char>(std::lround(c[k] * 255.0f));
+    }
+    writeAtomically(path, [&](const std::string& tmp) {
+        FILE* f = std::fopen(tmp.c_str(), "wb");
+        if (!f) throw std::runtime_error("cannot open");
+        png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+        png_infop info = png ? png_create_info_struct(png) : nullptr;
+        if (!png || !info || setjmp(png_jmpbuf(png))) {
+            png_destroy_write_struct(&png, &info);
+            std::fclose(f);
+            throw std::runtime_error("libpng failed");
+        }
+        png_init_io(png, f);
+        png_set_IHDR(png, info, w, h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                     PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+        png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+        png_write_info(png, info);
+        for (int y = 0; y < h; ++y) png_write_row(png, &pixels[static_cast<size_t>(y) * w * 3]);
+        png_write_end(png, nullptr);
+        png_destroy_write_struct(&png, &info);
+        if (std::fclose(f) != 0) throw std::runtime_error("close failed");
+    });
+}
+
+void writeExr(const std::string& path, int width, int height, const std::vector<float>& rgba) {
+    writeAtomically(path, [&](const std::string& tmp) {
+        Imf::Header header(width, height);
+        const char* names[4] = {"R", "G", "B", "A"};
+        Imf::FrameBuffer fb;
+        for (int c = 0; c < 4; ++c) {
+            header.channels().insert(names[c], Imf::Channel(Imf::FLOAT));
+            fb.insert(names[c], Imf::Slice(Imf::FLOAT, (char*)(rgba.data() + c),
+                                           4 * sizeof(float), 4 * sizeof(float) * width));
+        }
+        Imf::OutputFile file(tmp.c_str(), header);
+        file.setFrameBuffer(fb);
+        file.writePixels(height);
+    });
+}
+
+}  // namespace shrefract

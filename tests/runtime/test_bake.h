@@ -1,0 +1,50 @@
+// Bakes built in memory for runtime tests: a welded octahedron (closed, sphere normals) laid out
+// by the bake's joining layout, with random SH weights. No tracing: the tests check that the GL
+// pipeline reproduces the CPU decompressor, whatever the weights are.
+#pragma once
+
+#include <random>
+
+#include "bake/layout.h"
+#include "common/bakefile.h"
+#include "common/scene.h"
+#include "common/sh.h"
+
+namespace shrefract::test {
+
+inline Mesh octahedron() {
+    Mesh m;
+    m.positions = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    m.normals = m.positions;
+    m.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                   {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+    return m;
+}
+
+// Random weights in [-1, 1] for x, y, z and [0, 2] for the length; band 0 biased so the exit
+// direction is rarely near zero.
+inline BakeData randomBake(int order, int rate, unsigned seed = 7) {
+    Scene scene;
+    Part part;
+    part.name = "octahedron";
+    part.mesh = octahedron();
+    scene.parts.push_back(part);
+    BakeData d;
+    d.order = order;
+    d.layout = buildJoiningLayout(scene, rate);
+    d.manifest = {{"media", {{{"name", "glass"}, {"ior", 1.5}, {"absorption", {0.1, 0.2, 0.3}}}}}};
+    const size_t n = d.layout.position.size();
+    d.weights.resize(shEvenCount(order) * n * 4);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    for (size_t k = 0; k < static_cast<size_t>(shEvenCount(order)); ++k)
+        for (size_t i = 0; i < n; ++i)
+            for (int c = 0; c < 4; ++c) {
+                float w = u(rng) / (1.0f + k);  // decaying like a band-limited signal
+                if (k == 0) w += c == 2 ? 3.0f : (c == 3 ? 2.0f : 0.0f);
+                d.weights[(k * n + i) * 4 + c] = w;
+            }
+    return d;
+}
+
+}  // namespace shrefract::test

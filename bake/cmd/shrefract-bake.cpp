@@ -6,9 +6,11 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 
 #include "bake/bake.h"
 #include "bake/layout.h"
+#include "bake/target.h"
 #include "bake/cmd/common_cli.h"
 #include "common/error.h"
 
@@ -29,6 +31,8 @@ int main(int argc, char** argv) {
     size_t samples = 35000;
     std::string cache = cli::defaultCacheDir();
     bool quiet = false;
+    double targetError = 0;
+    std::string targetReport;
     app.add_option("input", input, "mesh (.obj .off .ply .stl) or scene (.json)")->required();
     app.add_option("-o,--output", output, "output file, NAME.shrefract.exr")->required();
     app.add_option("--order", opt.order, "SH order L: bands 0..L")->capture_default_str()->check(CLI::Range(0, 20));
@@ -47,6 +51,11 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({"f32", "f16", "u8"}));
     app.add_option("--threads", opt.threads, "worker threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
     app.add_option("--cache", cache, "folder for cached compression matrices (empty: none)")->capture_default_str();
+    app.add_option("--target-error", targetError,
+                   "pick the smallest order, rate and grid whose median error on held-out "
+                   "directions is at most DEG degrees (overrides --order, --rate, --grid)")
+        ->check(CLI::Range(0.001, 180.0));
+    app.add_option("--target-report", targetReport, "write the --target-error search as JSON");
     app.add_flag("-q,--quiet", quiet, "no progress output");
     CLI11_PARSE(app, argc, argv);
 
@@ -67,6 +76,31 @@ int main(int argc, char** argv) {
         Scene scene = loadScene(input, medium);
         for (const Part& p : scene.parts)
             for (const std::string& w : p.report.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+
+        if (targetError > 0) {
+            TargetSearchOptions topt;
+            topt.targetDeg = targetError;
+            if (!quiet) std::fprintf(stderr, "target-error: searching order, rate and grid on held-out pairs...\n");
+            TargetSearchResult t = searchTarget(scene, opt, topt);
+            const TargetCandidate& c = t.chosen;
+            const TargetCandidate& p = t.reference;
+            std::printf("target-error %.3g deg: %s order %d, rate %d, grid %s: median %.2f deg, p95 %.1f deg\n",
+                        targetError, t.reached ? "chose" : "NOT REACHED; most accurate is", c.order, c.rate,
+                        c.grid.ToString().c_str(), c.medianDeg, c.p95Deg);
+            std::printf("  paper's fixed model (order 8, rate %d, grid 32x64): median %.2f deg, %.1f MB of "
+                        "weights, %.3g paths\n", p.rate, p.medianDeg, p.weightBytes / 1e6, p.bakeCost);
+            std::printf("  chosen: %.1f MB of weights (%.2fx less), %.3g paths (%.2fx less)\n", c.weightBytes / 1e6,
+                        double(p.weightBytes) / std::max<size_t>(1, c.weightBytes), c.bakeCost,
+                        p.bakeCost / std::max(1.0, c.bakeCost));
+            if (!targetReport.empty()) {
+                std::ofstream f(targetReport);
+                f << t.ToJson().dump(2) << "\n";
+                if (!f) throw inputError(targetReport, "cannot write");
+            }
+            opt.order = c.order;
+            opt.rate = c.rate;
+            opt.grid = c.grid;
+        }
 
         const bool tty = cli::stderrIsTerminal();
         int lastDecile = -1;

@@ -50,7 +50,7 @@ nlohmann::json errorStats(std::vector<double> e) {
 }
 
 nlohmann::json evaluateDirections(const BakeData& bake, const Scene& scene, size_t pairs,
-                                  uint64_t seed, int order) {
+                                  uint64_t seed, int order, float zMin, float zMax) {
     const SurfaceLayout& L = bake.layout;
     TraceOptions topt;
     const auto& m = bake.manifest;
@@ -69,8 +69,8 @@ nlohmann::json evaluateDirections(const BakeData& bake, const Scene& scene, size
     std::vector<Pair> draws(pairs);
     for (Pair& p : draws) {
         p.sample = S(rng);
-        // Uniform over the hemisphere: z = cos(theta) uniform in [0, 1).
-        float z = U(rng), phi = 6.28318530718f * U(rng), sxy = std::sqrt(std::max(0.0f, 1 - z * z));
+        // Uniform over the hemisphere: z = cos(theta) uniform in [0, 1) (Archimedes).
+        float z = zMin + (zMax - zMin) * U(rng), phi = 6.28318530718f * U(rng), sxy = std::sqrt(std::max(0.0f, 1 - z * z));
         p.omegaLocal = glm::vec3(sxy * std::cos(phi), sxy * std::sin(phi), z);
     }
     std::vector<double> angle(pairs), lenErr(pairs);

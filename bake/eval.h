@@ -21,9 +21,10 @@ Scene sceneOfBake(const BakeData& bake, const std::string& bakePath, const std::
 // Random (sample, omega) pairs, omega uniform over the outer hemisphere (so almost surely
 // between grid directions), decompressed against a fresh trace of the same path. Angular error
 // in degrees: mean, median, p95, p99, max; path-length error; the shares of TIR, capped and
-// re-entering paths, each with its own error. `order` < 0: all stored bands.
+// re-entering paths, each with its own error. `order` < 0: all stored bands. cos(theta) of omega
+// is drawn uniformly in [zMin, zMax): [0, 0.1) probes grazing entry alone.
 nlohmann::json evaluateDirections(const BakeData& bake, const Scene& scene, size_t pairs,
-                                  uint64_t seed, int order = -1);
+                                  uint64_t seed, int order = -1, float zMin = 0.0f, float zMax = 1.0f);
 
 // For each object-space surface point p and unit view direction w (toward the viewer): the
 // exit direction (normalized) and length the runtime would use there, interpolated across the

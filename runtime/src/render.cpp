@@ -70,8 +70,11 @@ RenderedFrame renderFrame(Refractor& refractor, const Environment& environment,
         glClearColor(0, 0, 0, 0);
         glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
         glm::mat4 view = glm::lookAt(camera.eye, camera.target, camera.up);
+        // Clip planes scale with the viewing distance, so objects of any size are drawn (a
+        // fixed 0.01..1000 lost spheres scaled by 1e-4 and 1e4: tests/stability).
+        const float distance = glm::length(camera.eye - camera.target);
         glm::mat4 projection = glm::perspective(glm::radians(camera.fovDegrees),
-                                                float(width) / float(height), 0.01f, 1000.0f);
+                                                float(width) / float(height), 1e-2f * distance, 1e2f * distance);
         glm::mat4 model(1.0f);
         refractor.update(camera.eye, model);
         environment.drawBackground(view, projection);

@@ -250,7 +250,8 @@ int main(int argc, char** argv) {
                           t.unpack, t.shade);
             glfwSetWindowTitle(window, title);
             if (now - lastReport > std::chrono::seconds(1) || last_frame) {
-                std::printf("%s%s\n", title + 17,  // without "shrefract-view | " v.timings ? "" : " (stage timings off)");
+                // Stdout gets the title without its "shrefract-view | " prefix.
+                std::printf("%s%s\n", title + 17, v.timings ? "" : " (stage timings off)");
                 std::fflush(stdout);
                 lastReport = now;
             }

@@ -5,6 +5,8 @@
 #include <dlfcn.h>
 
 #include <cstdint>
+#include <cstring>
+#include <string>
 #include <vector>
 
 #include "gl.h"
@@ -75,6 +77,10 @@ std::string describeCurrent(gl::Loader loader) {
     return s(GL_RENDERER) + ", " + s(GL_VERSION);
 }
 
+// EGL without a window. Display: the first hardware EGL device (EGL_EXT_platform_device: NVIDIA's
+// driver, Mesa on a GPU render node), else Mesa's surfaceless platform (llvmpipe when there is no
+// GPU). Context: config-less (EGL_KHR_no_config_context), else from a pbuffer-capable config;
+// made current without a surface either way (EGL_KHR_surfaceless_context).
 class EglContext final : public HeadlessContext {
 public:
     EglContext() {
@@ -82,30 +88,16 @@ public:
             eglGetProcAddress("eglGetPlatformDisplayEXT"));
         if (!getPlatformDisplay)
             throw ContextError("EGL: eglGetPlatformDisplayEXT unavailable (no EGL_EXT_platform_base)");
-        display_ = getPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-        EGLint major = 0, minor = 0;
-        if (display_ == EGL_NO_DISPLAY || !eglInitialize(display_, &major, &minor))
-            throw ContextError("EGL: no surfaceless display (needs Mesa's "
-                               "EGL_MESA_platform_surfaceless); error 0x" + hex(eglGetError()));
-        if (!eglBindAPI(EGL_OPENGL_API)) {
-            eglTerminate(display_);
-            throw ContextError("EGL: desktop OpenGL API not available");
+        std::string tried;
+        for (EGLDisplay d : hardwareDisplays(getPlatformDisplay)) {
+            if (tryDisplay(d, &tried)) return;
         }
-        for (int version : {45, 33}) {
-            EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION, version / 10,
-                                EGL_CONTEXT_MINOR_VERSION, version % 10,
-                                EGL_CONTEXT_OPENGL_PROFILE_MASK,
-                                EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
-            context_ = eglCreateContext(display_, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attribs);
-            if (context_ != EGL_NO_CONTEXT) break;
-        }
-        if (context_ == EGL_NO_CONTEXT) {
-            EGLint e = eglGetError();
-            eglTerminate(display_);
-            throw ContextError("EGL: cannot create a 3.3 core context without config "
-                               "(EGL_KHR_no_config_context); error 0x" + hex(e));
-        }
-        makeCurrent();
+        EGLDisplay d = getPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+        if (d == EGL_NO_DISPLAY)
+            throw ContextError("EGL: no GPU device and no surfaceless display (needs "
+                               "EGL_EXT_platform_device or Mesa's EGL_MESA_platform_surfaceless); "
+                               "error 0x" + hex(eglGetError()) + tried);
+        if (!tryDisplay(d, &tried)) throw ContextError("EGL: no usable display" + tried);
     }
     ~EglContext() override {
         eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
@@ -121,6 +113,69 @@ public:
     std::string description() const override { return describeCurrent(&eglLoader); }
 
 private:
+    // Displays of the EGL devices that are not Mesa's software rasterizer, in device order.
+    static std::vector<EGLDisplay> hardwareDisplays(PFNEGLGETPLATFORMDISPLAYEXTPROC getDisplay) {
+        auto queryDevices =
+            reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+        auto queryString = reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(
+            eglGetProcAddress("eglQueryDeviceStringEXT"));
+        std::vector<EGLDisplay> out;
+        EGLDeviceEXT devices[16];
+        EGLint count = 0;
+        if (!queryDevices || !queryString || !queryDevices(16, devices, &count)) return out;
+        for (EGLint i = 0; i < count; ++i) {
+            const char* ext = queryString(devices[i], EGL_EXTENSIONS);
+            if (ext && std::strstr(ext, "EGL_MESA_device_software")) continue;
+            EGLDisplay d = getDisplay(EGL_PLATFORM_DEVICE_EXT, devices[i], nullptr);
+            if (d != EGL_NO_DISPLAY) out.push_back(d);
+        }
+        return out;
+    }
+
+    // Initializes `d` and makes a 4.5 (else 3.3) core context current on it; on failure appends
+    // the reason to `why` and leaves nothing behind.
+    bool tryDisplay(EGLDisplay d, std::string* why) {
+        EGLint major = 0, minor = 0;
+        if (!eglInitialize(d, &major, &minor)) {
+            *why += "; eglInitialize: error 0x" + hex(eglGetError());
+            return false;
+        }
+        if (!eglBindAPI(EGL_OPENGL_API)) {
+            *why += "; desktop OpenGL API not available";
+            return false;
+        }
+        EGLConfig config = EGL_NO_CONFIG_KHR;
+        for (int attempt = 0; attempt < 2 && context_ == EGL_NO_CONTEXT; ++attempt) {
+            if (attempt == 1) {  // no EGL_KHR_no_config_context: any desktop-GL config
+                const EGLint want[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE,
+                                       EGL_OPENGL_BIT, EGL_NONE};
+                EGLint n = 0;
+                if (!eglChooseConfig(d, want, &config, 1, &n) || n < 1) break;
+            }
+            for (int version : {45, 33}) {
+                EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION, version / 10,
+                                    EGL_CONTEXT_MINOR_VERSION, version % 10,
+                                    EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                                    EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+                context_ = eglCreateContext(d, config, EGL_NO_CONTEXT, attribs);
+                if (context_ != EGL_NO_CONTEXT) break;
+            }
+        }
+        if (context_ == EGL_NO_CONTEXT) {
+            *why += "; cannot create a 3.3 core context: error 0x" + hex(eglGetError());
+            return false;
+        }
+        display_ = d;
+        if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_)) {
+            *why += "; eglMakeCurrent without surface failed (EGL_KHR_surfaceless_context?)";
+            eglDestroyContext(display_, context_);
+            context_ = EGL_NO_CONTEXT;
+            display_ = EGL_NO_DISPLAY;
+            return false;
+        }
+        return true;
+    }
+
     static std::string hex(EGLint v) {
         char b[16];
         std::snprintf(b, sizeof b, "%04x", static_cast<unsigned>(v));

@@ -134,7 +134,8 @@ Environment::~Environment() {
     glDeleteVertexArrays(1, &vao_);
 }
 
-void Environment::drawBackground(const glm::mat4& view, const glm::mat4& projection) const {
+void Environment::drawBackground(const glm::mat4& view, const glm::mat4& projection, bool toneMap,
+                                 float exposure) const {
     ensureLoaded(currentContextLoader());
     GLint viewport[4];
     glGetIntegerv(GL_VIEWPORT, viewport);
@@ -145,6 +146,8 @@ void Environment::drawBackground(const glm::mat4& view, const glm::mat4& project
     glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
     glUseProgram(program_);
     glUniform1i(glGetUniformLocation(program_, "uEnvironment"), 0);
+    glUniform1i(glGetUniformLocation(program_, "uToneMap"), toneMap ? 1 : 0);
+    glUniform1f(glGetUniformLocation(program_, "uExposure"), exposure);
     glUniformMatrix4fv(glGetUniformLocation(program_, "uInverseViewProjection"), 1, GL_FALSE,
                        glm::value_ptr(inverse));
     glUniform2f(glGetUniformLocation(program_, "uViewport"), float(viewport[2]), float(viewport[3]));

@@ -152,12 +152,22 @@ uniform samplerCube uEnvironment;
 uniform mat4 uInverseViewProjection;  // rotation-only view
 uniform vec2 uViewport;
 uniform vec2 uViewportOrigin;
+uniform bool uToneMap;
+uniform float uExposure;
 layout(location = 0) out vec4 oColor;
 layout(location = 1) out vec4 oDirection;
+
+vec3 toneMap(vec3 c) {  // as in the shading shader (runtime.h toneMap)
+    c *= uExposure;
+    c = clamp((c * (2.51 * c + 0.03)) / (c * (2.43 * c + 0.59) + 0.14), 0.0, 1.0);
+    return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
+}
+
 void main() {
     vec2 ndc = (gl_FragCoord.xy - uViewportOrigin) / uViewport * 2.0 - 1.0;
     vec4 d = uInverseViewProjection * vec4(ndc, 1.0, 1.0);
-    oColor = vec4(texture(uEnvironment, normalize(d.xyz / d.w)).rgb, 1.0);
+    vec3 c = texture(uEnvironment, normalize(d.xyz / d.w)).rgb;
+    oColor = vec4(uToneMap ? toneMap(c) : c, 1.0);
     oDirection = vec4(0.0);
 }
 )";

@@ -74,7 +74,8 @@ struct Refractor::Impl {
     Bake bake;
     RefractorOptions options;
     gl::Loader loader = nullptr;
-    int order = 0;
+    int order = 0, maxOrder = 0;  // in use; uploaded
+    GpuMemory memory;
     bool smoothing = false, correction = true;
     int muW = 0, muH = 0, rhoW = 0, rhoH = 0, listWidth = 1;
     ShaderLimits limits;
@@ -152,7 +153,8 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
     const int n = L.sampleCount();
     if (n == 0 || L.muWidth * L.muHeight < n || L.triangleCount == 0)
         throw std::invalid_argument("shrefract: bake has an empty or inconsistent layout");
-    m->order = options.order < 0 ? d.order : std::min(options.order, d.order);
+    m->maxOrder = options.maxOrder < 0 ? d.order : std::min(options.maxOrder, d.order);
+    m->order = options.order < 0 ? m->maxOrder : std::min(options.order, m->maxOrder);
     m->smoothing = options.smoothing;
     m->correction = options.correction;
     m->muW = L.muWidth;
@@ -168,8 +170,14 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
                                    muImage3(L.position, m->muW, m->muH).data(), GL_NEAREST);
     m->normalTex = makeTexture2D(GL_RGB32F, m->muW, m->muH, GL_RGB, GL_FLOAT,
                                  muImage3(L.normal, m->muW, m->muH).data(), GL_NEAREST);
-    const int K = d.coefficientCount();
+    // Only bands 0..maxOrder go to the GPU: the weights are coefficient-major, so those are the
+    // first shEvenCount(maxOrder) layers.
+    const int K = shEvenCount(m->maxOrder);
     const size_t layer = static_cast<size_t>(m->muW) * m->muH * 4;
+    const size_t muTexels = static_cast<size_t>(m->muW) * m->muH;
+    m->memory.weights = K * muTexels * 16;  // RGBA32F
+    m->memory.samples = 2 * muTexels * 12;  // P, N: RGB32F
+    m->memory.rho = static_cast<size_t>(m->rhoW) * m->rhoH * 16;  // RGBA32UI
     std::vector<float> padded(layer, 0.0f);
     if (m->limits.weightArray) {
         glGenTextures(1, &m->weightArray);
@@ -214,12 +222,14 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
                                        GL_UNSIGNED_INT, idx.data(), GL_NEAREST);
         m->nbrWeightTex = makeTexture2D(GL_R32F, m->listWidth, listH, GL_RED, GL_FLOAT,
                                         wts.data(), GL_NEAREST);
+        m->memory.neighbours = muTexels * 8 + idx.size() * 4 + wts.size() * 4;
     }
     m->localView.create(m->muW, m->muH, GL_NEAREST);
     m->sum[0].create(m->muW, m->muH, GL_NEAREST);
     m->sum[1].create(m->muW, m->muH, GL_NEAREST);
     m->smoothed.create(m->muW, m->muH, GL_NEAREST);
     m->rho.create(m->rhoW, m->rhoH, GL_LINEAR);
+    m->memory.targets = 4 * muTexels * 16 + static_cast<size_t>(m->rhoW) * m->rhoH * 16;
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 
     // Fixed programs.
@@ -438,13 +448,18 @@ glm::ivec2 Refractor::refractionMapSize() const { return {impl_->rhoW, impl_->rh
 
 void Refractor::setOrder(int L) {
     impl_->use();
-    impl_->order = std::clamp(L, 0, impl_->bake.order());
+    impl_->order = std::clamp(L, 0, impl_->maxOrder);
     impl_->compiledFor(impl_->order);
 }
 int Refractor::order() const { return impl_->order; }
 void Refractor::setSmoothing(bool on) { impl_->smoothing = on; }
 void Refractor::setCorrection(bool on) { impl_->correction = on; }
+void Refractor::setTimings(bool on) {
+    if (!on) impl_->timings = Timings{};
+    impl_->options.timings = on;
+}
 const Timings& Refractor::timings() const { return impl_->timings; }
+const GpuMemory& Refractor::memory() const { return impl_->memory; }
 int Refractor::passCount() const {
     return static_cast<int>(impl_->compiledFor(impl_->order).programs.size());
 }

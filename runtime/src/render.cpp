@@ -102,6 +102,86 @@ RenderedFrame renderFrame(Refractor& refractor, const Environment& environment,
     return out;
 }
 
+OffscreenTarget::OffscreenTarget(int width, int height) : width_(width), height_(height) {
+    if (width < 1 || height < 1) throw std::invalid_argument("shrefract: empty offscreen target");
+    ensureLoaded(currentContextLoader());
+    GLuint textures[2];
+    glGenTextures(2, textures);
+    color_ = textures[0];
+    directions_ = textures[1];
+    for (GLuint t : textures) {
+        glBindTexture(GL_TEXTURE_2D, t);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    }
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glGenRenderbuffers(1, &depth_);
+    glBindRenderbuffer(GL_RENDERBUFFER, depth_);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+    glGenFramebuffers(1, &fbo_);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, color_, 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, directions_, 0);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_);
+    bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (!complete) {
+        glDeleteFramebuffers(1, &fbo_);
+        glDeleteRenderbuffers(1, &depth_);
+        glDeleteTextures(2, textures);
+        throw std::runtime_error("shrefract: offscreen framebuffer incomplete");
+    }
+}
+
+OffscreenTarget::~OffscreenTarget() {
+    try {
+        ensureLoaded(currentContextLoader());
+    } catch (...) {
+        return;  // no context any more: nothing to release safely
+    }
+    if (fbo_) glDeleteFramebuffers(1, &fbo_);
+    if (depth_) glDeleteRenderbuffers(1, &depth_);
+    GLuint textures[2] = {color_, directions_};
+    glDeleteTextures(2, textures);
+    fbo_ = depth_ = color_ = directions_ = 0;
+}
+
+void OffscreenTarget::bind() {
+    ensureLoaded(currentContextLoader());
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(2, buffers);
+    glViewport(0, 0, width_, height_);
+    glClearColor(0, 0, 0, 0);
+    glDepthMask(GL_TRUE);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+}
+
+RenderedFrame OffscreenTarget::read() const {
+    ensureLoaded(currentContextLoader());
+    RenderedFrame out;
+    out.width = width_;
+    out.height = height_;
+    GLint previous = 0;
+    glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &previous);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
+    std::vector<float> rows(static_cast<size_t>(width_) * height_ * 4);
+    const size_t stride = static_cast<size_t>(width_) * 4;
+    for (int a = 0; a < 2; ++a) {
+        glReadBuffer(GL_COLOR_ATTACHMENT0 + a);
+        glPixelStorei(GL_PACK_ALIGNMENT, 1);
+        glReadPixels(0, 0, width_, height_, GL_RGBA, GL_FLOAT, rows.data());
+        std::vector<float>& dst = a == 0 ? out.color : out.directions;
+        dst.resize(rows.size());
+        // GL's rows are bottom-up.
+        for (int y = 0; y < height_; ++y)
+            std::copy_n(&rows[(height_ - 1 - y) * stride], stride, &dst[y * stride]);
+    }
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, previous);
+    return out;
+}
+
 namespace {
 
 // Writes through `write` to PATH.tmp, then renames: a failure leaves no file at `path`.

@@ -26,6 +26,28 @@ struct RenderedFrame {
     Timings timings;
 };
 
+// A framebuffer object in the current context for apps with no window (headless EGL has no
+// default framebuffer): colour RGBA32F (draw buffer 0), direction buffer RGBA32F (1), depth.
+class OffscreenTarget {
+public:
+    // Throws std::runtime_error if the driver refuses the framebuffer.
+    OffscreenTarget(int width, int height);
+    ~OffscreenTarget();
+    OffscreenTarget(const OffscreenTarget&) = delete;
+    OffscreenTarget& operator=(const OffscreenTarget&) = delete;
+    // Binds it with both draw buffers, sets the viewport, clears colour (to 0) and depth.
+    void bind();
+    // Waits for the GPU and reads both buffers back (rows top-down); timings left zero.
+    RenderedFrame read() const;
+    int width() const { return width_; }
+    int height() const { return height_; }
+    unsigned framebuffer() const { return fbo_; }
+
+private:
+    int width_ = 0, height_ = 0;
+    unsigned fbo_ = 0, color_ = 0, directions_ = 0, depth_ = 0;
+};
+
 // Renders one frame in the current context (object at the origin, identity model).
 RenderedFrame renderFrame(Refractor& refractor, const Environment& environment, const Camera& camera,
                   int width, int height);

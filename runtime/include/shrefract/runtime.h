@@ -3,6 +3,7 @@
 // Every GL entry point uses the caller's current OpenGL 3.3+ core context.
 #pragma once
 
+#include <cstddef>
 #include <memory>
 #include <string>
 #include <vector>
@@ -47,8 +48,10 @@ public:
     ~Environment();
     unsigned cubeMap() const { return texture_; }  // GL_TEXTURE_CUBE_MAP name
     int faceSize() const { return faceSize_; }
-    // Draws the environment behind everything (depth test LEQUAL at the far plane).
-    void drawBackground(const glm::mat4& view, const glm::mat4& projection) const;
+    // Draws the environment behind everything (no depth test, no depth write): linear HDR, or
+    // display values through toneMap() when `toneMap` (match RefractorOptions::toneMap).
+    void drawBackground(const glm::mat4& view, const glm::mat4& projection, bool toneMap = false,
+                        float exposure = 1.0f) const;
 
 private:
     Environment() = default;
@@ -70,9 +73,22 @@ struct Timings {
     int passes = 0;         // decompression passes used
 };
 
+// GPU memory a Refractor allocated, bytes of texel storage at the internal formats it asked
+// for (drivers may pad): what paper Figure 12 counts.
+struct GpuMemory {
+    size_t weights = 0;     // SH weights of the uploaded bands, RGBA32F, mu size each
+    size_t samples = 0;     // positions and normals, RGB32F, mu size
+    size_t rho = 0;         // rho index texture (which sample or correction per texel)
+    size_t neighbours = 0;  // smoothing lists (CSR)
+    size_t targets = 0;     // render targets: local view, two partial sums, smoothed, rho
+    size_t total() const { return weights + samples + rho + neighbours + targets; }
+};
+
 struct RefractorOptions {
     std::string preset = "modern";  // shader limits: "modern" or "2006" (runtime/src/shadergen.h)
     int order = -1;                 // SH order used, -1: all stored
+    int maxOrder = -1;              // bands uploaded to the GPU, 0..maxOrder (-1: all stored);
+                                    // setOrder() cannot go above it
     bool smoothing = false;         // spatial smoothing through the bake's neighbour lists
     bool correction = true;         // interpolation-correction texels in rho (paper §5.3.1)
     bool timings = true;            // GL timer queries around every stage
@@ -94,13 +110,16 @@ public:
               const Environment& environment);
     unsigned refractionMap() const;     // GL_TEXTURE_2D, RGBA32F rho layout, GL_LINEAR
     glm::ivec2 refractionMapSize() const;
-    // Progressive decompression (paper §6): use bands 0..L, L <= bake order (clamped).
+    // Progressive decompression (paper §6): use bands 0..L, clamped to the uploaded maxOrder.
     void setOrder(int L);
     int order() const;
     void setSmoothing(bool on);
     void setCorrection(bool on);  // off only to show the seams it removes
+    // GL timer queries per stage (RefractorOptions::timings); off zeroes timings().
+    void setTimings(bool on);
     const Timings& timings() const;
     int passCount() const;  // decompression passes at the current order
+    const GpuMemory& memory() const;
     // Writes the generated GLSL of the current order into `dir`.
     void dumpShaders(const std::string& dir) const;
     // Reads back D_mu after update() (smoothed if on): 4 floats per sample, sample order.

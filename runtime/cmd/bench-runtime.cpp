@@ -1,0 +1,332 @@
+// shrefract-bench-runtime: per-frame cost of the runtime on one bake, as JSON (run by
+// scripts/bench-runtime). For each preset x order x viewport:
+//   - throughput: stage timer queries off, median wall ms of a whole frame (update + draw +
+//     glFinish) and its GPU time (one GL_TIME_ELAPSED query around the frame);
+//   - breakdown: stage timer queries on (each stage finished inside its query), median ms of
+//     view, decompress, smooth, unpack, shade;
+//   - GPU texture bytes the refractor allocated with only bands 0..L uploaded (paper Fig. 12);
+// and, in the same run, a baseline: the same mesh drawn with one environment lookup per pixel
+// (refracted view direction at the front face, no decompression), for the ratio
+// runtime frame / plain environment-mapped draw.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <nlohmann/json.hpp>
+
+#include "common/bakefile.h"
+#include "gl.h"
+#include "shrefract/context.h"
+#include "shrefract/render.h"
+#include "shrefract/runtime.h"
+
+namespace {
+
+using namespace shrefract;
+using namespace shrefract::gl;
+using Clock = std::chrono::steady_clock;
+
+double median(std::vector<double> v) {
+    if (v.empty()) return 0;
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+}
+
+const char* kBaselineVertex = R"(#version 330 core
+layout(location = 0) in vec3 aPosition;
+layout(location = 1) in vec3 aNormal;
+uniform mat4 uViewProjection;
+out vec3 vPosition;
+out vec3 vNormal;
+void main() {
+    vPosition = aPosition;
+    vNormal = aNormal;
+    gl_Position = uViewProjection * vec4(aPosition, 1.0);
+}
+)";
+
+// One environment lookup along the view direction refracted at the front face.
+const char* kBaselineFragment = R"(#version 330 core
+uniform samplerCube uEnvironment;
+uniform vec3 uEye;
+uniform float uEta;
+in vec3 vPosition;
+in vec3 vNormal;
+layout(location = 0) out vec4 oColor;
+void main() {
+    vec3 v = normalize(vPosition - uEye);
+    vec3 t = refract(v, normalize(vNormal), 1.0 / uEta);
+    oColor = vec4(texture(uEnvironment, dot(t, t) > 0.0 ? t : v).rgb, 1.0);
+}
+)";
+
+// The plain mesh (triangle corners of the bake's layout) with an environment-lookup shader.
+struct Baseline {
+    GLuint program = 0, vao = 0, vbo = 0;
+    int vertices = 0;
+    explicit Baseline(const Bake& bake) {
+        const SurfaceLayout& L = bake.data().layout;
+        std::vector<float> data;
+        const glm::ivec2 corners[3] = {{0, 0}, {L.rate, 0}, {0, L.rate}};
+        for (int t = 0; t < L.triangleCount; ++t)
+            for (glm::ivec2 c : corners) {
+                uint32_t s = L.sampleAt(t, c.x, c.y);
+                const glm::vec3 &p = L.position[s], &n = L.normal[s];
+                data.insert(data.end(), {p.x, p.y, p.z, n.x, n.y, n.z});
+            }
+        vertices = L.triangleCount * 3;
+        program = buildProgram(kBaselineVertex, kBaselineFragment, "baseline");
+        glGenVertexArrays(1, &vao);
+        glBindVertexArray(vao);
+        glGenBuffers(1, &vbo);
+        glBindBuffer(GL_ARRAY_BUFFER, vbo);
+        glBufferData(GL_ARRAY_BUFFER, data.size() * sizeof(float), data.data(), GL_STATIC_DRAW);
+        glEnableVertexAttribArray(0);
+        glEnableVertexAttribArray(1);
+        glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
+        glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
+                              reinterpret_cast<void*>(3 * sizeof(float)));
+        glBindVertexArray(0);
+    }
+    ~Baseline() {
+        glDeleteProgram(program);
+        glDeleteBuffers(1, &vbo);
+        glDeleteVertexArrays(1, &vao);
+    }
+    void draw(const glm::mat4& viewProjection, glm::vec3 eye, float eta, const Environment& env) {
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LESS);
+        glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
+        glUseProgram(program);
+        glUniformMatrix4fv(glGetUniformLocation(program, "uViewProjection"), 1, GL_FALSE,
+                           glm::value_ptr(viewProjection));
+        glUniform3f(glGetUniformLocation(program, "uEye"), eye.x, eye.y, eye.z);
+        glUniform1f(glGetUniformLocation(program, "uEta"), eta);
+        glUniform1i(glGetUniformLocation(program, "uEnvironment"), 0);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_CUBE_MAP, env.cubeMap());
+        glBindVertexArray(vao);
+        glDrawArrays(GL_TRIANGLES, 0, vertices);
+        glBindVertexArray(0);
+        glUseProgram(0);
+    }
+};
+
+struct FrameTimes {
+    double wall = 0, gpu = 0;
+};
+
+// Runs `frames` frames after `warmup`, camera orbiting 1 degree per frame; `body(eye, view,
+// projection)` draws one. Returns medians; `perFrame` sees each timed frame.
+template <typename Body, typename PerFrame>
+FrameTimes timeFrames(OffscreenTarget& target, int warmup, int frames, bool gpuQuery, Body body,
+                      PerFrame perFrame) {
+    GLuint query = 0;
+    glGenQueries(1, &query);
+    std::vector<double> wall, gpu;
+    const glm::mat4 projection = glm::perspective(
+        glm::radians(45.0f), float(target.width()) / target.height(), 0.01f, 100.0f);
+    for (int f = 0; f < warmup + frames; ++f) {
+        Camera cam = Camera::orbit(30.0f + f, 20.0f, 3.0f);
+        glm::mat4 view = glm::lookAt(cam.eye, cam.target, cam.up);
+        glFinish();
+        auto t0 = Clock::now();
+        if (gpuQuery) glBeginQuery(GL_TIME_ELAPSED, query);
+        target.bind();
+        body(cam.eye, view, projection);
+        // Finish inside the query: llvmpipe rasterizes at the flush, not at submission.
+        glFinish();
+        if (gpuQuery) glEndQuery(GL_TIME_ELAPSED);
+        auto t1 = Clock::now();
+        ensureLoaded(currentContextLoader());
+        if (f < warmup) continue;
+        wall.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+        if (gpuQuery) {
+            GLuint64 ns = 0;
+            glGetQueryObjectui64v(query, GL_QUERY_RESULT, &ns);
+            gpu.push_back(ns * 1e-6);
+        }
+        perFrame();
+    }
+    glDeleteQueries(1, &query);
+    return {median(wall), median(gpu)};
+}
+
+std::vector<std::string> split(const std::string& text) {
+    std::vector<std::string> out;
+    std::stringstream ss(text);
+    std::string item;
+    while (std::getline(ss, item, ','))
+        if (!item.empty()) out.push_back(item);
+    return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"Per-frame cost of the shrefract runtime, as JSON"};
+    std::string bakePath, envPath, orders = "1,4,8", sizes = "1024x1024,1350x1100",
+                                      presets = "2006,modern", backend = "egl", jsonPath;
+    int frames = 15, warmup = 3;
+    bool smoothing = true;
+    app.add_option("bake", bakePath, "NAME.shrefract.exr")->required();
+    app.add_option("--env", envPath, "lat-long environment EXR")->required();
+    app.add_option("--orders", orders, "SH orders used, comma-separated")->capture_default_str();
+    app.add_option("--sizes", sizes, "viewports WxH, comma-separated")->capture_default_str();
+    app.add_option("--presets", presets, "shader limit presets")->capture_default_str();
+    app.add_option("--backend", backend, "egl | osmesa")->capture_default_str();
+    app.add_option("--frames", frames, "timed frames per measurement")->capture_default_str();
+    app.add_option("--warmup", warmup, "untimed frames first")->capture_default_str();
+    app.add_option("--smooth", smoothing, "neighbour-list smoothing on (true/false)")
+        ->capture_default_str();
+    app.add_option("--json", jsonPath, "output file (default: stdout)");
+    CLI11_PARSE(app, argc, argv);
+
+    try {
+        Bake bake = loadBake(bakePath);
+        auto context = createHeadlessContext(parseBackend(backend));
+        Environment env = Environment::loadLatLong(envPath);
+        ensureLoaded(currentContextLoader());
+        std::fprintf(stderr, "GL: %s\n", context->description().c_str());
+
+        nlohmann::json out;
+        out["renderer"] = context->description();
+        out["backend"] = backend;
+        out["bake"] = {{"path", bakePath},
+                       {"order", bake.order()},
+                       {"samples", bake.sampleCount()},
+                       {"triangles", bake.triangleCount()}};
+        out["method"] = {
+            {"frames", frames},
+            {"warmup", warmup},
+            {"statistic", "median"},
+            {"smoothing", smoothing},
+            {"frame", "update() + draw() of the object into a cleared RGBA32F offscreen target + "
+                      "glFinish; no background"},
+            {"throughput", "stage timer queries off; wall = CPU clock around the frame, gpu = one "
+                           "GL_TIME_ELAPSED query around it (glFinish inside)"},
+            {"stages", "stage timer queries on: each stage ends with glFinish inside its "
+                       "GL_TIME_ELAPSED query (a pipeline drain per stage)"},
+            {"memory", "texel bytes at the requested internal formats, bands 0..L uploaded"},
+            {"baseline", "same mesh, one environment lookup along the view ray refracted at the "
+                         "front face, no decompression"},
+            {"paper_figure12_MB", {{"1", 9}, {"4", 13}, {"8", 23}}}};
+
+        std::vector<glm::ivec2> viewports;
+        for (const std::string& s : split(sizes)) {
+            int w = 0, h = 0;
+            if (std::sscanf(s.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1)
+                throw std::invalid_argument("--sizes: bad viewport '" + s + "'");
+            viewports.push_back({w, h});
+        }
+
+        // Baseline per viewport.
+        nlohmann::json baseline = nlohmann::json::object();
+        std::vector<double> baselineMs;
+        {
+            Baseline plain(bake);
+            for (glm::ivec2 vp : viewports) {
+                OffscreenTarget target(vp.x, vp.y);
+                FrameTimes t = timeFrames(
+                    target, warmup, frames, true,
+                    [&](glm::vec3 eye, const glm::mat4& view, const glm::mat4& projection) {
+                        plain.draw(projection * view, eye, bake.ior(), env);
+                    },
+                    [] {});
+                std::string key = std::to_string(vp.x) + "x" + std::to_string(vp.y);
+                baseline[key] = {{"frame_wall_ms", t.wall}, {"frame_gpu_ms", t.gpu}};
+                baselineMs.push_back(t.wall);
+                std::fprintf(stderr, "baseline %s: %.2f ms\n", key.c_str(), t.wall);
+            }
+        }
+        out["baseline"] = baseline;
+
+        nlohmann::json runs = nlohmann::json::array();
+        nlohmann::json memory = nlohmann::json::object();
+        for (const std::string& preset : split(presets)) {
+            for (const std::string& orderText : split(orders)) {
+                const int order = std::stoi(orderText);
+                if (order > bake.order()) {
+                    std::fprintf(stderr, "skipping order %d > bake order %d\n", order,
+                                 bake.order());
+                    continue;
+                }
+                RefractorOptions options;
+                options.preset = preset;
+                options.order = order;
+                options.maxOrder = order;  // upload only what this order uses (Figure 12)
+                options.smoothing = smoothing;
+                options.loader = context->loader();
+                auto refractor = Refractor::create(bake, options);
+                const GpuMemory& m = refractor->memory();
+                memory[std::to_string(order)] = {
+                    {"weights", m.weights},       {"samples", m.samples},
+                    {"rho", m.rho},               {"neighbours", m.neighbours},
+                    {"targets", m.targets},       {"total_bytes", m.total()},
+                    {"total_MB", m.total() / 1e6}, {"total_MiB", m.total() / 1048576.0}};
+                for (size_t v = 0; v < viewports.size(); ++v) {
+                    glm::ivec2 vp = viewports[v];
+                    OffscreenTarget target(vp.x, vp.y);
+                    auto body = [&](glm::vec3 eye, const glm::mat4& view,
+                                    const glm::mat4& projection) {
+                        refractor->update(eye);
+                        refractor->draw(view, projection, glm::mat4(1.0f), env);
+                    };
+                    refractor->setTimings(false);
+                    FrameTimes t = timeFrames(target, warmup, frames, true, body, [] {});
+                    refractor->setTimings(true);
+                    std::vector<double> st[5];
+                    FrameTimes timed = timeFrames(target, 1, frames, false, body, [&] {
+                        const Timings& s = refractor->timings();
+                        const double values[5] = {s.view, s.decompress, s.smooth, s.unpack,
+                                                  s.shade};
+                        for (int i = 0; i < 5; ++i) st[i].push_back(values[i]);
+                    });
+                    nlohmann::json run = {
+                        {"preset", preset},
+                        {"order", order},
+                        {"viewport", std::to_string(vp.x) + "x" + std::to_string(vp.y)},
+                        {"passes", refractor->passCount()},
+                        {"frame_wall_ms", t.wall},
+                        {"frame_gpu_ms", t.gpu},
+                        {"fps", t.wall > 0 ? 1000.0 / t.wall : 0.0},
+                        {"ratio_to_baseline", baselineMs[v] > 0 ? t.wall / baselineMs[v] : 0.0},
+                        {"stages_ms",
+                         {{"view", median(st[0])},
+                          {"decompress", median(st[1])},
+                          {"smooth", median(st[2])},
+                          {"unpack", median(st[3])},
+                          {"shade", median(st[4])}}},
+                        {"frame_wall_ms_with_stage_timers", timed.wall}};
+                    std::fprintf(stderr, "%s order %d %dx%d: %.2f ms (x%.2f baseline)\n",
+                                 preset.c_str(), order, vp.x, vp.y, t.wall,
+                                 run["ratio_to_baseline"].get<double>());
+                    runs.push_back(run);
+                }
+            }
+        }
+        out["runs"] = runs;
+        out["memory_by_order"] = memory;
+
+        const std::string text = out.dump(2) + "\n";
+        if (jsonPath.empty()) {
+            std::fputs(text.c_str(), stdout);
+        } else {
+            std::ofstream file(jsonPath);
+            file << text;
+            if (!file) throw std::runtime_error(jsonPath + ": cannot write");
+        }
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "shrefract-bench-runtime: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}

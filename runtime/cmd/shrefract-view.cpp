@@ -1,0 +1,267 @@
+// shrefract-view: interactive viewer for a bake (GLFW window, OpenGL 3.3 core).
+//   shrefract-view BAKE --env ENV.exr [--size WxH] [--order L] [--preset modern|2006] [--smooth]
+//                  [--exposure E] [--screenshot OUT.png --frames N] [--no-object]
+// Controls: left drag orbits, scroll zooms, Up/Down (or +/-) change the SH order used
+// (progressive decompression), S toggles smoothing, M cycles methods, T toggles per-stage
+// timings, P or F12 saves a screenshot, Esc quits. The title bar shows frame and stage times,
+// which are also printed once a second. No GUI toolkit: the HUD is the title bar and stdout.
+#define GLFW_INCLUDE_NONE  // GL comes from the runtime's loader (gl.h), not GL/gl.h
+#include <GLFW/glfw3.h>
+#include <png.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "gl.h"  // the runtime's loader: the viewer needs a handful of GL calls of its own
+#include "shrefract/render.h"
+#include "shrefract/runtime.h"
+
+namespace {
+
+using namespace shrefract::gl;
+
+// Methods the viewer can switch between. Only the SH refraction map exists in the runtime now;
+// baselines join this list when they land.
+const char* kMethods[] = {"sh"};
+
+struct Viewer {
+    float azimuth = 30.0f, elevation = 20.0f, distance = 3.0f;
+    bool dragging = false;
+    double lastX = 0, lastY = 0;
+    int order = 0, maxOrder = 0, method = 0;
+    bool smoothing = false, timings = true, screenshot = false, quit = false;
+};
+
+// 8-bit RGB PNG, rows top-down; throws naming the file.
+void writePng8(const std::string& path, int w, int h, const std::vector<unsigned char>& rgb) {
+    FILE* f = std::fopen(path.c_str(), "wb");
+    if (!f) throw std::runtime_error(path + ": cannot open for writing");
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+    png_infop info = png ? png_create_info_struct(png) : nullptr;
+    if (!png || !info || setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        std::fclose(f);
+        throw std::runtime_error(path + ": libpng failed");
+    }
+    png_init_io(png, f);
+    png_set_IHDR(png, info, w, h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    png_write_info(png, info);
+    for (int y = 0; y < h; ++y) png_write_row(png, &rgb[static_cast<size_t>(y) * w * 3]);
+    png_write_end(png, nullptr);
+    png_destroy_write_struct(&png, &info);
+    if (std::fclose(f) != 0) throw std::runtime_error(path + ": write failed");
+}
+
+// Reads the back buffer (display values: everything is drawn tone mapped) into a PNG.
+void saveScreenshot(const std::string& path, int w, int h) {
+    std::vector<unsigned char> rows(static_cast<size_t>(w) * h * 3), flipped(rows.size());
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    glReadBuffer(GL_BACK);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, rows.data());
+    const size_t stride = static_cast<size_t>(w) * 3;
+    for (int y = 0; y < h; ++y)
+        std::copy_n(&rows[(h - 1 - y) * stride], stride, &flipped[y * stride]);
+    writePng8(path, w, h, flipped);
+    std::printf("saved %s (%dx%d)\n", path.c_str(), w, h);
+}
+
+Viewer& state(GLFWwindow* window) { return *static_cast<Viewer*>(glfwGetWindowUserPointer(window)); }
+
+void onKey(GLFWwindow* window, int key, int, int action, int) {
+    if (action != GLFW_PRESS && action != GLFW_REPEAT) return;
+    Viewer& v = state(window);
+    switch (key) {
+        case GLFW_KEY_ESCAPE: v.quit = true; break;
+        case GLFW_KEY_UP: case GLFW_KEY_EQUAL: case GLFW_KEY_KP_ADD:
+            v.order = std::min(v.order + 1, v.maxOrder); break;
+        case GLFW_KEY_DOWN: case GLFW_KEY_MINUS: case GLFW_KEY_KP_SUBTRACT:
+            v.order = std::max(v.order - 1, 0); break;
+        case GLFW_KEY_S: v.smoothing = !v.smoothing; break;
+        case GLFW_KEY_M: v.method = (v.method + 1) % static_cast<int>(std::size(kMethods)); break;
+        case GLFW_KEY_T: v.timings = !v.timings; break;
+        case GLFW_KEY_P: case GLFW_KEY_F12: v.screenshot = true; break;
+        default: break;
+    }
+}
+
+void onMouseButton(GLFWwindow* window, int button, int action, int) {
+    Viewer& v = state(window);
+    if (button != GLFW_MOUSE_BUTTON_LEFT) return;
+    v.dragging = action == GLFW_PRESS;
+    glfwGetCursorPos(window, &v.lastX, &v.lastY);
+}
+
+void onCursor(GLFWwindow* window, double x, double y) {
+    Viewer& v = state(window);
+    if (!v.dragging) return;
+    v.azimuth -= 0.4f * static_cast<float>(x - v.lastX);
+    v.elevation = std::clamp(v.elevation + 0.4f * static_cast<float>(y - v.lastY), -89.0f, 89.0f);
+    v.lastX = x;
+    v.lastY = y;
+}
+
+void onScroll(GLFWwindow* window, double, double dy) {
+    Viewer& v = state(window);
+    v.distance = std::clamp(v.distance * std::pow(0.9f, static_cast<float>(dy)), 0.2f, 100.0f);
+}
+
+void onGlfwError(int code, const char* text) {
+    std::fprintf(stderr, "shrefract-view: GLFW error 0x%x: %s\n", code, text);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"Interactive viewer for a shrefract bake"};
+    std::string bakePath, envPath, size = "1024x768", preset = "modern", screenshotPath;
+    int order = -1, frames = 0;
+    float exposure = 1.0f;
+    bool smoothing = false, noObject = false;
+    app.add_option("bake", bakePath, "NAME.shrefract.exr from shrefract-bake")->required();
+    app.add_option("--env", envPath, "lat-long environment EXR")->required();
+    app.add_option("--size", size, "window size WxH")->capture_default_str();
+    app.add_option("--order", order, "SH order used at start (default: all stored)");
+    app.add_option("--preset", preset, "shader limits: modern | 2006")->capture_default_str();
+    app.add_flag("--smooth", smoothing, "start with spatial smoothing on");
+    app.add_option("--exposure", exposure, "exposure before the tone map")->capture_default_str();
+    app.add_option("--screenshot", screenshotPath, "save the last frame here and exit (with --frames)");
+    app.add_option("--frames", frames, "render N frames, then exit (0: run until Esc)");
+    app.add_flag("--no-object", noObject, "draw the environment only (a reference for tests)");
+    CLI11_PARSE(app, argc, argv);
+
+    int width = 0, height = 0;
+    char x = 0;
+    std::istringstream sizeStream(size);
+    if (!(sizeStream >> width >> x >> height) || x != 'x' || width < 16 || height < 16) {
+        std::fprintf(stderr, "shrefract-view: --size: expected WxH, got '%s'\n", size.c_str());
+        return 1;
+    }
+    if (!screenshotPath.empty() && frames <= 0) frames = 1;
+
+    glfwSetErrorCallback(onGlfwError);
+    if (!glfwInit()) {
+        std::fprintf(stderr, "shrefract-view: cannot initialise GLFW (no display?)\n");
+        return 1;
+    }
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+    glfwWindowHint(GLFW_DEPTH_BITS, 24);
+    GLFWwindow* window = glfwCreateWindow(width, height, "shrefract-view", nullptr, nullptr);
+    if (!window) {
+        std::fprintf(stderr, "shrefract-view: cannot open a window with OpenGL 3.3 core\n");
+        glfwTerminate();
+        return 1;
+    }
+    glfwMakeContextCurrent(window);
+    glfwSwapInterval(frames > 0 ? 0 : 1);
+
+    int status = 0;
+    try {
+        ensureLoaded(reinterpret_cast<Loader>(&glfwGetProcAddress));
+        std::printf("GL: %s, %s\n", reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
+                    reinterpret_cast<const char*>(glGetString(GL_VERSION)));
+        shrefract::Bake bake = shrefract::loadBake(bakePath);
+        shrefract::Environment env = shrefract::Environment::loadLatLong(envPath);
+        shrefract::RefractorOptions options;
+        options.preset = preset;
+        options.order = order;
+        options.smoothing = smoothing;
+        options.toneMap = true;  // straight to the window: display values
+        options.exposure = exposure;
+        options.loader = reinterpret_cast<Loader>(&glfwGetProcAddress);
+        auto refractor = shrefract::Refractor::create(bake, options);
+
+        Viewer v;
+        v.order = refractor->order();
+        v.maxOrder = bake.order();
+        v.smoothing = smoothing;
+        glfwSetWindowUserPointer(window, &v);
+        glfwSetKeyCallback(window, onKey);
+        glfwSetMouseButtonCallback(window, onMouseButton);
+        glfwSetCursorPosCallback(window, onCursor);
+        glfwSetScrollCallback(window, onScroll);
+        std::printf("bake: order %d, %d samples, %d triangles; %.1f MB of GPU textures\n"
+                    "keys: drag orbit, scroll zoom, Up/Down order, S smoothing, M method, "
+                    "T timings, P/F12 screenshot, Esc quit\n",
+                    bake.order(), bake.sampleCount(), bake.triangleCount(),
+                    refractor->memory().total() / 1e6);
+
+        using Clock = std::chrono::steady_clock;
+        auto last = Clock::now(), lastReport = last;
+        double frameMs = 0;
+        int frame = 0, shots = 0;
+        while (!glfwWindowShouldClose(window) && !v.quit) {
+            if (v.order != refractor->order()) refractor->setOrder(v.order);
+            refractor->setSmoothing(v.smoothing);
+            refractor->setTimings(v.timings);
+
+            int fbw = 0, fbh = 0;
+            glfwGetFramebufferSize(window, &fbw, &fbh);
+            shrefract::Camera cam = shrefract::Camera::orbit(v.azimuth, v.elevation, v.distance);
+            glm::mat4 view = glm::lookAt(cam.eye, cam.target, cam.up);
+            glm::mat4 projection = glm::perspective(glm::radians(cam.fovDegrees),
+                                                    float(fbw) / std::max(1, fbh), 0.01f, 1000.0f);
+            if (!noObject) refractor->update(cam.eye);
+            glBindFramebuffer(GL_FRAMEBUFFER, 0);
+            glViewport(0, 0, fbw, fbh);
+            glClearColor(0, 0, 0, 1);
+            glDepthMask(GL_TRUE);
+            glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+            env.drawBackground(view, projection, true, exposure);
+            if (!noObject) refractor->draw(view, projection, glm::mat4(1.0f), env);
+            ensureLoaded(reinterpret_cast<Loader>(&glfwGetProcAddress));
+
+            ++frame;
+            const bool last_frame = frames > 0 && frame >= frames;
+            if (v.screenshot || (last_frame && !screenshotPath.empty())) {
+                glFinish();
+                std::string path = last_frame && !screenshotPath.empty()
+                                       ? screenshotPath
+                                       : "shrefract-view-" + std::to_string(shots++) + ".png";
+                saveScreenshot(path, fbw, fbh);
+                v.screenshot = false;
+            }
+            glfwSwapBuffers(window);
+            glfwPollEvents();
+
+            auto now = Clock::now();
+            frameMs = std::chrono::duration<double, std::milli>(now - last).count();
+            last = now;
+            const shrefract::Timings& t = refractor->timings();
+            char title[256];
+            std::snprintf(title, sizeof title,
+                          "shrefract-view | %s order %d (%d pass) smooth %s | %.1f ms/frame | "
+                          "view %.2f dec %.2f smooth %.2f unpack %.2f shade %.2f ms",
+                          kMethods[v.method], refractor->order(), refractor->passCount(),
+                          v.smoothing ? "on" : "off", frameMs, t.view, t.decompress, t.smooth,
+                          t.unpack, t.shade);
+            glfwSetWindowTitle(window, title);
+            if (now - lastReport > std::chrono::seconds(1) || last_frame) {
+                // Stdout gets the title without its "shrefract-view | " prefix.
+                std::printf("%s%s\n", title + 17, v.timings ? "" : " (stage timings off)");
+                std::fflush(stdout);
+                lastReport = now;
+            }
+            if (last_frame) break;
+        }
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "shrefract-view: %s\n", e.what());
+        status = 1;
+    }
+    glfwDestroyWindow(window);
+    glfwTerminate();
+    return status;
+}

@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# ViewerUnderXvfb: shrefract-view in a virtual X server renders a bake for a few frames and saves
+# a screenshot; the same view with --no-object is the reference. The glass must change at least
+# 5% of the pixels. Exit 77 (ctest SKIP_RETURN_CODE) when xvfb-run is missing.
+#   viewer_test.sh VIEWER PNG_DIFF BAKE ENV WORKDIR
+set -euo pipefail
+viewer=$1 png_diff=$2 bake=$3 env=$4 work=$5
+if ! command -v xvfb-run >/dev/null; then
+  echo "xvfb-run not found (apt-get install xvfb xauth): skipped"
+  exit 77
+fi
+mkdir -p "$work"
+rm -f "$work/shot.png" "$work/background.png"
+run() { xvfb-run -a -s "-screen 0 800x600x24" "$viewer" "$bake" --env "$env" --size 640x480 "$@"; }
+run --screenshot "$work/shot.png" --frames 3
+run --screenshot "$work/background.png" --frames 3 --no-object
+"$png_diff" "$work/shot.png" "$work/background.png" 0.05

@@ -69,6 +69,20 @@ struct MediaStack {
 
 float iorOf(const Scene& s, int part) { return part < 0 ? 1.0f : float(s.parts[part].medium.ior); }
 
+// One closest-hit query from org along dir, t in [0, inf).
+RTCRayHit closestHit(RTCScene scene, RTCIntersectContext* ctx, glm::vec3 org, glm::vec3 dir) {
+    RTCRayHit rh;
+    rh.ray.org_x = org.x, rh.ray.org_y = org.y, rh.ray.org_z = org.z;
+    rh.ray.dir_x = dir.x, rh.ray.dir_y = dir.y, rh.ray.dir_z = dir.z;
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = std::numeric_limits<float>::infinity();
+    rh.ray.mask = 0xFFFFFFFF;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(scene, ctx, &rh);
+    return rh;
+}
+
 }  // namespace
 
 Tracer::Tracer(const Scene& scene, TraceOptions options)
@@ -109,15 +123,7 @@ Tracer::~Tracer() = default;
 bool Tracer::intersect(glm::vec3 org, glm::vec3 dir, float* t) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
-    RTCRayHit rh;
-    rh.ray.org_x = org.x, rh.ray.org_y = org.y, rh.ray.org_z = org.z;
-    rh.ray.dir_x = dir.x, rh.ray.dir_y = dir.y, rh.ray.dir_z = dir.z;
-    rh.ray.tnear = 0.0f;
-    rh.ray.tfar = std::numeric_limits<float>::infinity();
-    rh.ray.mask = 0xFFFFFFFF;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(rtc_->scene, &ctx, &rh);
+    RTCRayHit rh = closestHit(rtc_->scene, &ctx, org, dir);
     *t = rh.ray.tfar;
     return rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
 }
@@ -146,15 +152,7 @@ PathResult Tracer::trace(glm::vec3 p, glm::vec3 n, glm::vec3 omega, uint32_t par
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     for (;;) {
-        RTCRayHit rh;
-        rh.ray.org_x = org.x, rh.ray.org_y = org.y, rh.ray.org_z = org.z;
-        rh.ray.dir_x = d.x, rh.ray.dir_y = d.y, rh.ray.dir_z = d.z;
-        rh.ray.tnear = 0.0f;
-        rh.ray.tfar = std::numeric_limits<float>::infinity();
-        rh.ray.mask = 0xFFFFFFFF;
-        rh.ray.flags = 0;
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(rtc_->scene, &ctx, &rh);
+        const RTCRayHit rh = closestHit(rtc_->scene, &ctx, org, d);
         if (log) log->push_back({org, d});
         ++res.rays;
 

@@ -35,7 +35,12 @@ TraceOptions traceOptionsOfBake(const BakeData& bake) {
     return t;
 }
 
-EvalBuffer renderReference(const Tracer& tracer, const LatLongImage& env,
+ReferenceEnvironment::ReferenceEnvironment(LatLongImage image, bool cubeMap, int faceSize)
+    : latLong(std::move(image)), viaCubeMap(cubeMap) {
+    if (viaCubeMap) cube = cubeFromLatLong(latLong, faceSize);
+}
+
+EvalBuffer renderReference(const Tracer& tracer, const ReferenceEnvironment& env,
                            const ReferenceView& view, ReferenceStats* stats) {
     const auto start = std::chrono::steady_clock::now();
     EvalBuffer out;
@@ -57,7 +62,7 @@ EvalBuffer renderReference(const Tracer& tracer, const LatLongImage& env,
                     const glm::vec3 d = primaryRay(view, x, y);
                     SurfaceHit h;
                     if (!tracer.hit(view.eye, d, &h)) {
-                        out.color[i] = glm::vec4(sampleLatLong(env, d), 0.0f);
+                        out.color[i] = glm::vec4(env(d), 0.0f);
                         continue;
                     }
                     ++nCovered;
@@ -80,8 +85,8 @@ EvalBuffer renderReference(const Tracer& tracer, const LatLongImage& env,
                     const float F = FresnelDielectric(glm::dot(ns, omega), eta);
                     const glm::vec3 kappa(medium.absorption);
                     const glm::vec3 transmitted =
-                        sampleLatLong(env, r.exit) * glm::exp(-kappa * std::max(r.length, 0.0f));
-                    const glm::vec3 reflected = sampleLatLong(env, Reflect(omega, ns));
+                        env(r.exit) * glm::exp(-kappa * std::max(r.length, 0.0f));
+                    const glm::vec3 reflected = env(Reflect(omega, ns));
                     out.color[i] = glm::vec4(F * reflected + (1.0f - F) * transmitted, 1.0f);
                     out.direction[i] = r.exit;
                 }

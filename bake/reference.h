@@ -29,6 +29,18 @@ glm::vec3 primaryRay(const ReferenceView& view, int x, int y);
 // The bake's path rules as recorded in its manifest (branch, maxBounces).
 TraceOptions traceOptionsOfBake(const BakeData& bake);
 
+// The environment as the reference looks it up: by default through the runtime's own cube map
+// (the same faces, GL_LINEAR inside a face), else bilinearly in the lat-long image.
+struct ReferenceEnvironment {
+    LatLongImage latLong;
+    CubeMapImage cube;
+    bool viaCubeMap = true;
+    explicit ReferenceEnvironment(LatLongImage image, bool viaCubeMap = true, int faceSize = 0);
+    glm::vec3 operator()(glm::vec3 d) const {
+        return viaCubeMap ? sampleCube(cube, d) : sampleLatLong(latLong, glm::normalize(d));
+    }
+};
+
 struct ReferenceStats {
     double milliseconds = 0;  // wall time of the whole frame
     size_t covered = 0;       // pixels whose primary ray hit the object
@@ -40,10 +52,9 @@ struct ReferenceStats {
 //   colour = F * env(reflect) + (1 - F) * env(exit) * exp(-kappa_q * length)
 // with F = FresnelDielectric(n . omega, ior_q), exit and length from tracer.trace(hit, n, omega,
 // q) (omega = -ray direction; if n faces away from the viewer the geometric normal enters
-// instead, as rule 3 does later on the path), env = sampleLatLong (bilinear in the lat-long
-// image; the GL path resamples it into a cube map first). Background pixels show env(ray),
-// coverage 0. Tiles of 16x16 pixels in parallel (TBB).
-EvalBuffer renderReference(const Tracer& tracer, const LatLongImage& environment,
+// instead, as rule 3 does later on the path), env = ReferenceEnvironment. Background pixels
+// show env(ray), coverage 0. Tiles of 16x16 pixels in parallel (TBB).
+EvalBuffer renderReference(const Tracer& tracer, const ReferenceEnvironment& environment,
                            const ReferenceView& view, ReferenceStats* stats = nullptr);
 
 // d_N of Wyman 2005 per point: the distance from p along the inward normal -n to the next

@@ -23,4 +23,19 @@ LatLongImage loadLatLong(const std::string& path);
 glm::vec3 sampleLatLong(const LatLongImage& image, glm::vec3 d);
 glm::vec3 sampleLatLong(int width, int height, const std::vector<float>& rgb, glm::vec3 d);
 
+// The runtime's cube map of a lat-long image (runtime/src/environment.cpp uploads exactly these
+// faces): OpenGL face order +x, -x, +y, -y, +z, -z; texel (x, y) of a face holds
+// sampleLatLong at the direction through its centre, row y = 0 uploaded first (t = 0).
+struct CubeMapImage {
+    int faceSize = 0;
+    std::vector<float> faces[6];  // RGB, faceSize^2 texels each
+};
+// faceSize 0: height / 2 (the runtime's default).
+CubeMapImage cubeFromLatLong(const LatLongImage& image, int faceSize = 0);
+// The direction through (s, t) in [-1, 1]^2 of face f, OpenGL's face orientation table.
+glm::vec3 cubeFaceDirection(int face, float s, float t);
+// GL_LINEAR lookup as the GL spec selects faces (major axis) and coordinates. Within half a
+// texel of a face edge GL's seamless filtering blends the neighbour face; this clamps instead.
+glm::vec3 sampleCube(const CubeMapImage& cube, glm::vec3 d);
+
 }  // namespace shrefract

@@ -61,6 +61,7 @@ int main(int argc, char** argv) {
     int order = -1, frames = 5;
     bool smoothing = false;
     std::string method = "sh", wymanTir = "reflect", scenePath;
+    bool latLongLookup = false;
     app.add_option("bake", bakePath, "NAME.shrefract.exr from shrefract-bake")->required();
     app.add_option("--env", envPath, "lat-long environment EXR")->required();
     app.add_option("--camera", camera, "orbit:AZ,EL,DIST (degrees, degrees, object units)");
@@ -83,6 +84,9 @@ int main(int argc, char** argv) {
     app.add_option("--wyman-tir", wymanTir,
                    "Wyman at total internal reflection: reflect | straight | grazing")
         ->capture_default_str();
+    app.add_flag("--latlong-lookup", latLongLookup,
+                 "raytrace: look the environment up bilinearly in the lat-long image, not through "
+                 "the runtime's cube map");
     app.add_option("--scene", scenePath,
                    "raytrace, wyman: the baked mesh or scene, if not where the manifest says");
     app.add_option("--dump-shaders", dumpDir, "write the generated GLSL into DIR");
@@ -142,7 +146,7 @@ int main(int argc, char** argv) {
         }
         if (method == "raytrace") {
             // The CPU reference: no GL context at all.
-            shrefract::LatLongImage envImage = shrefract::loadLatLong(envPath);
+            shrefract::ReferenceEnvironment envImage(shrefract::loadLatLong(envPath), !latLongLookup);
             shrefract::ReferenceView view;
             view.eye = cam.eye, view.target = cam.target, view.up = cam.up;
             view.fovDegrees = cam.fovDegrees, view.width = width, view.height = height;

@@ -15,22 +15,6 @@ namespace shrefract {
 
 using namespace gl;
 
-namespace {
-
-// Direction through (s, t) in [-1, 1]^2 of cube face f, OpenGL's face orientation table.
-glm::vec3 faceDirection(int f, float s, float t) {
-    switch (f) {
-        case 0: return {1, -t, -s};
-        case 1: return {-1, -t, s};
-        case 2: return {s, 1, t};
-        case 3: return {s, -1, -t};
-        case 4: return {s, -t, 1};
-        default: return {-s, -t, -1};
-    }
-}
-
-}  // namespace
-
 Environment Environment::loadLatLong(const std::string& path, int faceSize) {
     LatLongImage image = shrefract::loadLatLong(path);
     return fromLatLong(image.width, image.height, image.rgb, faceSize);
@@ -43,24 +27,17 @@ Environment Environment::fromLatLong(int width, int height, const std::vector<fl
     ensureLoaded(currentContextLoader());
     Environment env;
     env.faceSize_ = faceSize > 0 ? faceSize : std::max(1, height / 2);
-    const int n = env.faceSize_;
+    // The faces are built on the CPU (common/latlong.h), where the reference renderer reads
+    // the same ones.
+    LatLongImage image{width, height, rgb};
+    const CubeMapImage cube = cubeFromLatLong(image, env.faceSize_);
+    const int n = cube.faceSize;
     glGenTextures(1, &env.texture_);
     glBindTexture(GL_TEXTURE_CUBE_MAP, env.texture_);
-    std::vector<float> face(static_cast<size_t>(n) * n * 3);
     for (int f = 0; f < 6; ++f) {
-        for (int y = 0; y < n; ++y)
-            for (int x = 0; x < n; ++x) {
-                glm::vec3 d = glm::normalize(
-                    faceDirection(f, 2.0f * (x + 0.5f) / n - 1.0f, 2.0f * (y + 0.5f) / n - 1.0f));
-                glm::vec3 c = sampleLatLong(width, height, rgb, d);
-                float* o = &face[(static_cast<size_t>(y) * n + x) * 3];
-                o[0] = c.r;
-                o[1] = c.g;
-                o[2] = c.b;
-            }
         glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
         glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, 0, GL_RGB32F, n, n, 0, GL_RGB, GL_FLOAT,
-                     face.data());
+                     cube.faces[f].data());
     }
     glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);

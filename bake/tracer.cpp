@@ -128,6 +128,35 @@ bool Tracer::intersect(glm::vec3 org, glm::vec3 dir, float* t) const {
     return rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
 }
 
+bool Tracer::hit(glm::vec3 org, glm::vec3 dir, SurfaceHit* out) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh;
+    rh.ray.org_x = org.x, rh.ray.org_y = org.y, rh.ray.org_z = org.z;
+    rh.ray.dir_x = dir.x, rh.ray.dir_y = dir.y, rh.ray.dir_z = dir.z;
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = std::numeric_limits<float>::infinity();
+    rh.ray.mask = 0xFFFFFFFF;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(rtc_->scene, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    // The same surface point and normals as trace() computes at its hits.
+    const Mesh& m = scene_.parts[rh.hit.geomID].mesh;
+    const glm::uvec3 tri = m.triangles[rh.hit.primID];
+    const float u = rh.hit.u, v = rh.hit.v, w = 1.0f - u - v;
+    out->t = rh.ray.tfar;
+    out->part = rh.hit.geomID;
+    out->triangle = rh.hit.primID;
+    out->p = w * m.positions[tri[0]] + u * m.positions[tri[1]] + v * m.positions[tri[2]];
+    out->ng = glm::normalize(glm::cross(m.positions[tri[1]] - m.positions[tri[0]],
+                                        m.positions[tri[2]] - m.positions[tri[0]]));
+    glm::vec3 ns = w * m.normals[tri[0]] + u * m.normals[tri[1]] + v * m.normals[tri[2]];
+    float len = glm::length(ns);
+    out->ns = len > 0 ? ns / len : out->ng;
+    return true;
+}
+
 PathResult Tracer::trace(glm::vec3 p, glm::vec3 n, glm::vec3 omega, uint32_t part,
                          std::vector<LoggedRay>* log) const {
     PathResult res;

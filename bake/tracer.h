@@ -41,6 +41,16 @@ struct LoggedRay {
     glm::vec3 org, dir;
 };
 
+// The first surface a ray meets (Tracer::hit): the exact mesh, as the tracer sees it.
+struct SurfaceHit {
+    float t = 0.0f;        // ray parameter (distance for a unit direction)
+    uint32_t part = 0;     // scene part = Embree geometry id
+    uint32_t triangle = 0;
+    glm::vec3 p{0.0f};     // barycentric point on the triangle (not org + t * dir)
+    glm::vec3 ng{0.0f};    // unit geometric normal, outward (counter-clockwise winding)
+    glm::vec3 ns{0.0f};    // interpolated vertex normal, normalized (ng if it vanishes)
+};
+
 class Tracer {
 public:
     // Builds one Embree scene over all parts. Throws std::runtime_error on Embree errors.
@@ -57,6 +67,8 @@ public:
 
     // A bare closest-hit query, nothing else: the ceiling the benchmark compares against.
     bool intersect(glm::vec3 org, glm::vec3 dir, float* t) const;
+    // Closest hit with its surface: what a primary ray of the reference renderer sees.
+    bool hit(glm::vec3 org, glm::vec3 dir, SurfaceHit* out) const;
 
     // Ray offsets scale with the scene: this times its bounding-box extent.
     float epsilon() const { return epsilon_; }

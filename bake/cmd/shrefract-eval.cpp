@@ -1,13 +1,17 @@
 // shrefract-eval: how close a bake comes to the truth.
 //   directions BAKE --pairs N --seed S --json REPORT.json   decompressed vs freshly traced
 //   query BAKE --in Q.csv --out A.csv                        exit direction per (point, view)
+//   image --ref A.exr --test B.exr [--heatmap H.png] [--json R.json]   two evaluation buffers
+//   montage --out M.png IMG.exr... [--labels L...] [--errors]        labelled side by side
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include "bake/eval.h"
+#include "bake/image_eval.h"
 #include "common/error.h"
 
 using namespace shrefract;
@@ -71,9 +75,74 @@ int main(int argc, char** argv) {
     query->add_option("bake", bakePath, "NAME.shrefract.exr")->required();
     query->add_option("--in", inPath, "CSV rows px,py,pz,wx,wy,wz (object space, w toward the viewer)")->required();
     query->add_option("--out", outPath, "CSV rows ex,ey,ez,len")->required();
+    std::string refPath, testPath, heatPath, outPng;
+    float maxDeg = 30.0f, exposure = 1.0f;
+    auto* image = app.add_subcommand("image", "compare two render evaluation buffers (docs/evaluation.md)");
+    image->add_option("--ref", refPath, "reference evaluation buffer EXR (shrefract-render --dirs)")->required();
+    image->add_option("--test", testPath, "tested evaluation buffer EXR")->required();
+    image->add_option("--heatmap", heatPath, "angular error heat map PNG");
+    image->add_option("--max-deg", maxDeg, "heat map: degrees at the top of the ramp")->capture_default_str();
+    image->add_option("--exposure", exposure, "exposure before the tone map")->capture_default_str();
+    image->add_option("--json", jsonPath, "write the report here");
+    std::vector<std::string> inputs, labels;
+    bool withErrors = false;
+    auto* mont = app.add_subcommand("montage", "labelled side-by-side PNG of evaluation buffers (paper Figure 11)");
+    mont->add_option("inputs", inputs, "evaluation buffer EXRs, the reference first")->required();
+    mont->add_option("--labels", labels, "one label per input (default: file names)");
+    mont->add_option("--out", outPng, "montage PNG")->required();
+    mont->add_flag("--errors", withErrors, "a second row: angular error heat maps against the first input");
+    mont->add_option("--max-deg", maxDeg, "heat map: degrees at the top of the ramp")->capture_default_str();
+    mont->add_option("--exposure", exposure, "exposure before the tone map")->capture_default_str();
     CLI11_PARSE(app, argc, argv);
 
     try {
+        if (image->parsed()) {
+            EvalBuffer ref = readEvalBuffer(refPath), test = readEvalBuffer(testPath);
+            nlohmann::json r = compareImages(ref, test, exposure);
+            r["ref"] = refPath;
+            r["test"] = testPath;
+            const auto& a = r["angleDeg"];
+            if (a["count"].get<size_t>() > 0)
+                std::printf("angular error, degrees, %zu pixels both cover: mean %.3f median %.3f p95 %.3f max %.3f\n",
+                            a["count"].get<size_t>(), a["mean"].get<double>(), a["median"].get<double>(),
+                            a["p95"].get<double>(), a["max"].get<double>());
+            else
+                std::printf("angular error: no pixel covered by both\n");
+            std::printf("coverage: ref %zu, test %zu, mismatch %zu (ref only %zu, test only %zu)\n",
+                        r["coverage"]["ref"].get<size_t>(), r["coverage"]["test"].get<size_t>(),
+                        r["coverage"]["mismatch"].get<size_t>(), r["coverage"]["refOnly"].get<size_t>(),
+                        r["coverage"]["testOnly"].get<size_t>());
+            std::printf("tone-mapped: PSNR %.2f dB, SSIM %.4f\n", r["psnr"].get<double>(), r["ssim"].get<double>());
+            if (!heatPath.empty()) writePng8(heatPath, heatMap(ref, test, maxDeg, exposure));
+            if (!jsonPath.empty()) writeAtomically(jsonPath, r.dump(2) + "\n");
+            return 0;
+        }
+        if (mont->parsed()) {
+            if (!labels.empty() && labels.size() != inputs.size())
+                throw InputError("montage: " + std::to_string(labels.size()) + " labels for " +
+                                 std::to_string(inputs.size()) + " inputs");
+            std::vector<EvalBuffer> buffers;
+            for (const std::string& p : inputs) buffers.push_back(readEvalBuffer(p));
+            std::vector<std::vector<Image8>> rows(withErrors ? 2 : 1);
+            std::vector<std::vector<std::string>> text(rows.size());
+            for (size_t i = 0; i < buffers.size(); ++i) {
+                rows[0].push_back(toneMapped(buffers[i], exposure));
+                text[0].push_back(labels.empty() ? std::filesystem::path(inputs[i]).stem().string() : labels[i]);
+                if (!withErrors) continue;
+                nlohmann::json r = compareImages(buffers[0], buffers[i], exposure);
+                rows[1].push_back(heatMap(buffers[0], buffers[i], maxDeg, exposure));
+                char line[64];
+                if (r["angleDeg"]["count"].get<size_t>() > 0)
+                    std::snprintf(line, sizeof line, "median %.1f p95 %.1f deg",
+                                  r["angleDeg"]["median"].get<double>(), r["angleDeg"]["p95"].get<double>());
+                else
+                    std::snprintf(line, sizeof line, "no overlap");
+                text[1].push_back(line);
+            }
+            writePng8(outPng, montage(rows, text, 2));
+            std::printf("montage of %zu -> %s\n", buffers.size(), outPng.c_str());
+            return 0;
+        }
         BakeData bake = readBake(bakePath);
         if (dirs->parsed()) {
             Scene scene = sceneOfBake(bake, bakePath, scenePath);

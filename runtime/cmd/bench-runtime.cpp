@@ -25,6 +25,7 @@
 #include "common/bakefile.h"
 #include "gl.h"
 #include "shrefract/context.h"
+#include "shrefract/baselines.h"
 #include "shrefract/render.h"
 #include "shrefract/runtime.h"
 
@@ -40,85 +41,6 @@ double median(std::vector<double> v) {
     return v[v.size() / 2];
 }
 
-const char* kBaselineVertex = R"(#version 330 core
-layout(location = 0) in vec3 aPosition;
-layout(location = 1) in vec3 aNormal;
-uniform mat4 uViewProjection;
-out vec3 vPosition;
-out vec3 vNormal;
-void main() {
-    vPosition = aPosition;
-    vNormal = aNormal;
-    gl_Position = uViewProjection * vec4(aPosition, 1.0);
-}
-)";
-
-// One environment lookup along the view direction refracted at the front face.
-const char* kBaselineFragment = R"(#version 330 core
-uniform samplerCube uEnvironment;
-uniform vec3 uEye;
-uniform float uEta;
-in vec3 vPosition;
-in vec3 vNormal;
-layout(location = 0) out vec4 oColor;
-void main() {
-    vec3 v = normalize(vPosition - uEye);
-    vec3 t = refract(v, normalize(vNormal), 1.0 / uEta);
-    oColor = vec4(texture(uEnvironment, dot(t, t) > 0.0 ? t : v).rgb, 1.0);
-}
-)";
-
-// The plain mesh (triangle corners of the bake's layout) with an environment-lookup shader.
-struct Baseline {
-    GLuint program = 0, vao = 0, vbo = 0;
-    int vertices = 0;
-    explicit Baseline(const Bake& bake) {
-        const SurfaceLayout& L = bake.data().layout;
-        std::vector<float> data;
-        const glm::ivec2 corners[3] = {{0, 0}, {L.rate, 0}, {0, L.rate}};
-        for (int t = 0; t < L.triangleCount; ++t)
-            for (glm::ivec2 c : corners) {
-                uint32_t s = L.sampleAt(t, c.x, c.y);
-                const glm::vec3 &p = L.position[s], &n = L.normal[s];
-                data.insert(data.end(), {p.x, p.y, p.z, n.x, n.y, n.z});
-            }
-        vertices = L.triangleCount * 3;
-        program = buildProgram(kBaselineVertex, kBaselineFragment, "baseline");
-        glGenVertexArrays(1, &vao);
-        glBindVertexArray(vao);
-        glGenBuffers(1, &vbo);
-        glBindBuffer(GL_ARRAY_BUFFER, vbo);
-        glBufferData(GL_ARRAY_BUFFER, data.size() * sizeof(float), data.data(), GL_STATIC_DRAW);
-        glEnableVertexAttribArray(0);
-        glEnableVertexAttribArray(1);
-        glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
-        glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
-                              reinterpret_cast<void*>(3 * sizeof(float)));
-        glBindVertexArray(0);
-    }
-    ~Baseline() {
-        glDeleteProgram(program);
-        glDeleteBuffers(1, &vbo);
-        glDeleteVertexArrays(1, &vao);
-    }
-    void draw(const glm::mat4& viewProjection, glm::vec3 eye, float eta, const Environment& env) {
-        glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_LESS);
-        glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
-        glUseProgram(program);
-        glUniformMatrix4fv(glGetUniformLocation(program, "uViewProjection"), 1, GL_FALSE,
-                           glm::value_ptr(viewProjection));
-        glUniform3f(glGetUniformLocation(program, "uEye"), eye.x, eye.y, eye.z);
-        glUniform1f(glGetUniformLocation(program, "uEta"), eta);
-        glUniform1i(glGetUniformLocation(program, "uEnvironment"), 0);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_CUBE_MAP, env.cubeMap());
-        glBindVertexArray(vao);
-        glDrawArrays(GL_TRIANGLES, 0, vertices);
-        glBindVertexArray(0);
-        glUseProgram(0);
-    }
-};
 
 struct FrameTimes {
     double wall = 0, gpu = 0;
@@ -232,13 +154,18 @@ int main(int argc, char** argv) {
         nlohmann::json baseline = nlohmann::json::object();
         std::vector<double> baselineMs;
         {
-            Baseline plain(bake);
+            // The plain environment-mapped draw is the single-sided refraction baseline.
+            BaselineOptions bo;
+            bo.method = BaselineMethod::Single;
+            bo.timings = false;
+            std::unique_ptr<Baseline> plain = Baseline::create(bake, {}, bo);
             for (glm::ivec2 vp : viewports) {
                 OffscreenTarget target(vp.x, vp.y);
                 FrameTimes t = timeFrames(
                     target, warmup, frames, true,
                     [&](glm::vec3 eye, const glm::mat4& view, const glm::mat4& projection) {
-                        plain.draw(projection * view, eye, bake.ior(), env);
+                        (void)eye;
+                        plain->draw(view, projection, glm::mat4(1.0f), env);
                     },
                     [] {});
                 std::string key = std::to_string(vp.x) + "x" + std::to_string(vp.y);

@@ -3,11 +3,10 @@
 #include <cmath>
 #include <stdexcept>
 
-#include <ImfArray.h>
-#include <ImfRgbaFile.h>
 #include <glm/gtc/type_ptr.hpp>
 
 #include "common/error.h"
+#include "common/latlong.h"
 #include "gl.h"
 #include "glsl.h"
 #include "shrefract/runtime.h"
@@ -16,64 +15,9 @@ namespace shrefract {
 
 using namespace gl;
 
-namespace {
-
-// Bilinear lookup in the lat-long image at direction d (convention in runtime.h).
-glm::vec3 sampleLatLong(int w, int h, const std::vector<float>& rgb, glm::vec3 d) {
-    float u = 0.5f + std::atan2(d.x, -d.z) / (2.0f * float(M_PI));
-    float v = std::acos(std::clamp(d.y, -1.0f, 1.0f)) / float(M_PI);
-    float x = u * w - 0.5f, y = std::clamp(v * h - 0.5f, 0.0f, float(h - 1));
-    int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
-    float fx = x - x0, fy = y - y0;
-    auto at = [&](int xi, int yi) {
-        xi = ((xi % w) + w) % w;
-        yi = std::clamp(yi, 0, h - 1);
-        const float* p = &rgb[(static_cast<size_t>(yi) * w + xi) * 3];
-        return glm::vec3(p[0], p[1], p[2]);
-    };
-    return (1 - fx) * (1 - fy) * at(x0, y0) + fx * (1 - fy) * at(x0 + 1, y0) +
-           (1 - fx) * fy * at(x0, y0 + 1) + fx * fy * at(x0 + 1, y0 + 1);
-}
-
-// Direction through (s, t) in [-1, 1]^2 of cube face f, OpenGL's face orientation table.
-glm::vec3 faceDirection(int f, float s, float t) {
-    switch (f) {
-        case 0: return {1, -t, -s};
-        case 1: return {-1, -t, s};
-        case 2: return {s, 1, t};
-        case 3: return {s, -1, -t};
-        case 4: return {s, -t, 1};
-        default: return {-s, -t, -1};
-    }
-}
-
-}  // namespace
-
 Environment Environment::loadLatLong(const std::string& path, int faceSize) {
-    std::vector<float> rgb;
-    int w = 0, h = 0;
-    try {
-        Imf::RgbaInputFile file(path.c_str());
-        Imath::Box2i dw = file.dataWindow();
-        w = dw.max.x - dw.min.x + 1;
-        h = dw.max.y - dw.min.y + 1;
-        Imf::Array2D<Imf::Rgba> pixels(h, w);
-        file.setFrameBuffer(&pixels[0][0] - dw.min.x - dw.min.y * w, 1, w);
-        file.readPixels(dw.min.y, dw.max.y);
-        rgb.resize(static_cast<size_t>(w) * h * 3);
-        for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x) {
-                const Imf::Rgba& p = pixels[y][x];
-                float* o = &rgb[(static_cast<size_t>(y) * w + x) * 3];
-                o[0] = p.r;
-                o[1] = p.g;
-                o[2] = p.b;
-            }
-    } catch (const std::exception& e) {
-        throw inputError(path, std::string("cannot read environment EXR: ") + e.what());
-    }
-    if (w < 2 || h < 1) throw inputError(path, "environment image is empty");
-    return fromLatLong(w, h, rgb, faceSize);
+    LatLongImage image = shrefract::loadLatLong(path);
+    return fromLatLong(image.width, image.height, image.rgb, faceSize);
 }
 
 Environment Environment::fromLatLong(int width, int height, const std::vector<float>& rgb,
@@ -83,24 +27,17 @@ Environment Environment::fromLatLong(int width, int height, const std::vector<fl
     ensureLoaded(currentContextLoader());
     Environment env;
     env.faceSize_ = faceSize > 0 ? faceSize : std::max(1, height / 2);
-    const int n = env.faceSize_;
+    // The faces are built on the CPU (common/latlong.h), where the reference renderer reads
+    // the same ones.
+    LatLongImage image{width, height, rgb};
+    const CubeMapImage cube = cubeFromLatLong(image, env.faceSize_);
+    const int n = cube.faceSize;
     glGenTextures(1, &env.texture_);
     glBindTexture(GL_TEXTURE_CUBE_MAP, env.texture_);
-    std::vector<float> face(static_cast<size_t>(n) * n * 3);
     for (int f = 0; f < 6; ++f) {
-        for (int y = 0; y < n; ++y)
-            for (int x = 0; x < n; ++x) {
-                glm::vec3 d = glm::normalize(
-                    faceDirection(f, 2.0f * (x + 0.5f) / n - 1.0f, 2.0f * (y + 0.5f) / n - 1.0f));
-                glm::vec3 c = sampleLatLong(width, height, rgb, d);
-                float* o = &face[(static_cast<size_t>(y) * n + x) * 3];
-                o[0] = c.r;
-                o[1] = c.g;
-                o[2] = c.b;
-            }
         glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
         glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, 0, GL_RGB32F, n, n, 0, GL_RGB, GL_FLOAT,
-                     face.data());
+                     cube.faces[f].data());
     }
     glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);

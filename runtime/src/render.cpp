@@ -14,6 +14,8 @@
 #include <ImfHeader.h>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "common/tonemap.h"
+#include "shrefract/baselines.h"
 #include "gl.h"
 
 namespace shrefract {
@@ -31,16 +33,25 @@ Camera Camera::orbit(float azimuthDeg, float elevationDeg, float distance, glm::
     return c;
 }
 
-glm::vec3 toneMap(glm::vec3 c, float exposure) {
-    c *= exposure;
-    c = glm::clamp((c * (2.51f * c + 0.03f)) / (c * (2.43f * c + 0.59f) + 0.14f), 0.0f, 1.0f);
-    for (int i = 0; i < 3; ++i)
-        c[i] = c[i] <= 0.0031308f ? 12.92f * c[i] : 1.055f * std::pow(c[i], 1.0f / 2.4f) - 0.055f;
-    return c;
+glm::vec3 toneMap(glm::vec3 c, float exposure) { return toneMapAces(c, exposure); }
+
+glm::mat4 viewMatrix(const Camera& camera) {
+    return glm::lookAt(camera.eye, camera.target, camera.up);
 }
 
-RenderedFrame renderFrame(Refractor& refractor, const Environment& environment,
-                          const Camera& camera, int width, int height) {
+glm::mat4 projectionMatrix(const Camera& camera, int width, int height) {
+    // Clip planes scale with the viewing distance, so objects of any size are drawn (a fixed
+    // 0.01..1000 lost spheres scaled by 1e-4 and 1e4: tests/stability).
+    const float distance = glm::length(camera.eye - camera.target);
+    return glm::perspective(glm::radians(camera.fovDegrees), float(width) / float(height),
+                            1e-2f * distance, 1e2f * distance);
+}
+
+namespace {
+
+// Offscreen colour + direction targets, the background, then `drawObject(view, projection)`.
+RenderedFrame renderWith(const std::function<void(const glm::mat4&, const glm::mat4&)>& drawObject,
+                         const Camera& camera, int width, int height) {
     ensureLoaded(currentContextLoader());
     RenderedFrame out;
     out.width = width;
@@ -69,16 +80,9 @@ RenderedFrame renderFrame(Refractor& refractor, const Environment& environment,
         glViewport(0, 0, width, height);
         glClearColor(0, 0, 0, 0);
         glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-        glm::mat4 view = glm::lookAt(camera.eye, camera.target, camera.up);
-        // Clip planes scale with the viewing distance, so objects of any size are drawn (a
-        // fixed 0.01..1000 lost spheres scaled by 1e-4 and 1e4: tests/stability).
-        const float distance = glm::length(camera.eye - camera.target);
-        glm::mat4 projection = glm::perspective(glm::radians(camera.fovDegrees),
-                                                float(width) / float(height), 1e-2f * distance, 1e2f * distance);
-        glm::mat4 model(1.0f);
-        refractor.update(camera.eye, model);
-        environment.drawBackground(view, projection);
-        refractor.draw(view, projection, model, environment);
+        glm::mat4 view = viewMatrix(camera);
+        glm::mat4 projection = projectionMatrix(camera, width, height);
+        drawObject(view, projection);
         glFinish();
         // Read back, flipping GL's bottom-up rows to top-down.
         std::vector<float> rows(static_cast<size_t>(width) * height * 4);
@@ -92,7 +96,6 @@ RenderedFrame renderFrame(Refractor& refractor, const Environment& environment,
             for (int y = 0; y < height; ++y)
                 std::copy_n(&rows[(height - 1 - y) * stride], stride, &dst[y * stride]);
         }
-        out.timings = refractor.timings();
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glDeleteFramebuffers(1, &fbo);
@@ -100,6 +103,33 @@ RenderedFrame renderFrame(Refractor& refractor, const Environment& environment,
     glDeleteTextures(2, textures);
     if (!complete) throw std::runtime_error("shrefract: offscreen framebuffer incomplete");
     return out;
+}
+
+}  // namespace
+
+RenderedFrame renderFrame(Refractor& refractor, const Environment& environment,
+                          const Camera& camera, int width, int height) {
+    const glm::mat4 model(1.0f);
+    RenderedFrame out = renderWith(
+        [&](const glm::mat4& view, const glm::mat4& projection) {
+            refractor.update(camera.eye, model);
+            environment.drawBackground(view, projection);
+            refractor.draw(view, projection, model, environment);
+        },
+        camera, width, height);
+    out.timings = refractor.timings();
+    return out;
+}
+
+RenderedFrame renderFrame(Baseline& baseline, const Environment& environment,
+                          const Camera& camera, int width, int height) {
+    const glm::mat4 model(1.0f);
+    return renderWith(
+        [&](const glm::mat4& view, const glm::mat4& projection) {
+            environment.drawBackground(view, projection);
+            baseline.draw(view, projection, model, environment);
+        },
+        camera, width, height);
 }
 
 OffscreenTarget::OffscreenTarget(int width, int height) : width_(width), height_(height) {

@@ -2,6 +2,7 @@
 // the file, a non-zero exit and no output file; what is already on disk is kept.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -19,7 +20,11 @@ struct CommandResult {
 
 CommandResult run(const std::string& args) {
     fs::create_directories(SHREFRACT_TEST_TMP);
-    std::string log = std::string(SHREFRACT_TEST_TMP) + "/cli_log.txt";
+    // One log per test: ctest runs the cases as parallel processes.
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string name = std::string(info->test_suite_name()) + "." + info->name();
+    std::replace(name.begin(), name.end(), '/', '_');
+    std::string log = std::string(SHREFRACT_TEST_TMP) + "/log_" + name + ".txt";
     int status = std::system((args + " > " + log + " 2>&1").c_str());
     std::ifstream f(log);
     std::stringstream ss;
@@ -51,7 +56,7 @@ class BakeRejects : public ::testing::TestWithParam<BadCase> {};
 
 TEST_P(BakeRejects, WithAClearErrorAndNoOutput) {
     const BadCase& c = GetParam();
-    std::string in = tmp(c.file);
+    std::string in = tmp(std::string(c.name) + "_" + c.file);  // parallel cases: own files
     if (c.content) write(in, c.content);
     std::string out = tmp(std::string("bad_") + c.name + ".shrefract.exr");
     fs::remove(out);
@@ -60,7 +65,7 @@ TEST_P(BakeRejects, WithAClearErrorAndNoOutput) {
     EXPECT_NE(r.out.find(c.expect), std::string::npos) << "message: " << r.out;
     EXPECT_FALSE(fs::exists(out));
     for (auto& e : fs::directory_iterator(SHREFRACT_TEST_TMP))
-        EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << "left behind: " << e.path();
+        EXPECT_NE(e.path().string().rfind(out + ".tmp", 0), 0u) << "left behind: " << e.path();
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -81,8 +86,8 @@ INSTANTIATE_TEST_SUITE_P(
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(BakeCli, MissingOutputFolderIsAnErrorBeforeAnyWork) {
-    write(tmp("tetra.off"), kTetra);
-    CommandResult r = run(kBake + " " + tmp("tetra.off") + " -o " + tmp("no/such/dir/x.shrefract.exr") + " -q");
+    write(tmp("nodir_tetra.off"), kTetra);
+    CommandResult r = run(kBake + " " + tmp("nodir_tetra.off") + " -o " + tmp("no/such/dir/x.shrefract.exr") + " -q");
     EXPECT_NE(r.code, 0);
     EXPECT_NE(r.out.find("does not exist"), std::string::npos) << r.out;
 }
@@ -101,10 +106,10 @@ TEST(BakeCli, BadInputKeepsAnExistingOutputFile) {
 // A whole small bake, then the evaluation tools on it: the error table, and query answers
 // agreeing with the table's decompression at sample positions.
 TEST(BakeCli, BakesAndEvaluatesATetrahedron) {
-    write(tmp("tetra.off"), kTetra);
+    write(tmp("full_tetra.off"), kTetra);
     std::string out = tmp("tetra.shrefract.exr");
     fs::remove(out);
-    CommandResult b = run(kBake + " " + tmp("tetra.off") + " -o " + out + " --rate 2 --grid 8x16 --order 4 --cache ''");
+    CommandResult b = run(kBake + " " + tmp("full_tetra.off") + " -o " + out + " --rate 2 --grid 8x16 --order 4 --cache ''");
     ASSERT_EQ(b.code, 0) << b.out;
     EXPECT_NE(b.out.find("samples"), std::string::npos);
     EXPECT_TRUE(fs::exists(out));

@@ -1,12 +1,17 @@
 // Offscreen rendering of a bake for tools and tests: the library behind shrefract-render.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include "shrefract/runtime.h"
+
+namespace shrefract {
+class Baseline;
+}
 
 namespace shrefract {
 
@@ -51,6 +56,14 @@ private:
 // Renders one frame in the current context (object at the origin, identity model).
 RenderedFrame renderFrame(Refractor& refractor, const Environment& environment, const Camera& camera,
                   int width, int height);
+// The same frame with a baseline method (shrefract/baselines.h); frame.timings stays zero: read
+// baseline.timings().
+RenderedFrame renderFrame(Baseline& baseline, const Environment& environment, const Camera& camera,
+                          int width, int height);
+// The view and projection matrices renderFrame uses (glm::lookAt, glm::perspective, near 0.01,
+// far 1000): the reference renderer's camera must match them (docs/evaluation.md).
+glm::mat4 viewMatrix(const Camera& camera);
+glm::mat4 projectionMatrix(const Camera& camera, int width, int height);
 
 // Writes 8-bit sRGB PNG of toneMap(color), or float RGBA EXR; throws std::runtime_error naming
 // the file. Both write to a temporary name and rename, so a failure leaves no file.

@@ -1,0 +1,295 @@
+#include "bake/image_eval.h"
+
+#include <png.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "bake/eval.h"
+#include "common/error.h"
+#include "common/tonemap.h"
+
+namespace shrefract {
+
+namespace {
+
+glm::vec3 toneMappedPixel(const EvalBuffer& b, size_t i, float exposure) {
+    return toneMapAces(glm::vec3(b.color[i]), exposure);
+}
+
+float luminance(glm::vec3 c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
+
+void checkSameSize(const EvalBuffer& a, const EvalBuffer& b) {
+    if (a.width != b.width || a.height != b.height)
+        throw InputError("image sizes differ: " + std::to_string(a.width) + "x" +
+                         std::to_string(a.height) + " vs " + std::to_string(b.width) + "x" +
+                         std::to_string(b.height));
+}
+
+// 5x7 bitmap glyphs, row by row, '#' set. Upper case, digits and a little punctuation.
+struct Glyph {
+    char c;
+    const char* rows;  // 35 characters
+};
+const Glyph kFont[] = {
+    {'A', " ### #   ##   #######   ##   ##   #"}, {'B', "#### #   ##   ##### #   ##   ##### "},
+    {'C', " ### #   ##    #    #    #   # ### "}, {'D', "#### #   ##   ##   ##   ##   ##### "},
+    {'E', "######    #    #### #    #    #####"}, {'F', "######    #    #### #    #    #    "},
+    {'G', " ### #   ##    # ####   ##   # ####"}, {'H', "#   ##   ##   #######   ##   ##   #"},
+    {'I', " ###   #    #    #    #    #   ### "}, {'J', "  ###   #    #    #    # #  #  ##  "},
+    {'K', "#   ##  # # #  ##   # #  #  # #   #"}, {'L', "#    #    #    #    #    #    #####"},
+    {'M', "#   ### ### # ## # ##   ##   ##   #"}, {'N', "#   ##   ###  ## # ##  ###   ##   #"},
+    {'O', " ### #   ##   ##   ##   ##   # ### "}, {'P', "#### #   ##   ##### #    #    #    "},
+    {'Q', " ### #   ##   ##   ## # ##  #  ## #"}, {'R', "#### #   ##   ##### # #  #  # #   #"},
+    {'S', " #####    #     ###     #    ##### "}, {'T', "#####  #    #    #    #    #    #  "},
+    {'U', "#   ##   ##   ##   ##   ##   # ### "}, {'V', "#   ##   ##   ##   ##   # # #   #  "},
+    {'W', "#   ##   ##   ## # ## # ## # # # # "}, {'X', "#   ##   # # #   #   # # #   ##   #"},
+    {'Y', "#   ##   # # #   #    #    #    #  "}, {'Z', "#####    #   #   #   #   #    #####"},
+    {'0', " ### #   ##  ### # ###  ##   # ### "}, {'1', "  #   ##    #    #    #    #   ### "},
+    {'2', " ### #   #    #   #   #   #   #####"}, {'3', "#####   #   #     #     ##   # ### "},
+    {'4', "   #   ##  # # #  # #####   #    # "}, {'5', "######    ####     #    ##   # ### "},
+    {'6', "  ##  #   #    #### #   ##   # ### "}, {'7', "#####    #   #   #   #    #    #   "},
+    {'8', " ### #   ##   # ### #   ##   # ### "}, {'9', " ### #   ##   # ####    #   #  ##  "},
+    {'.', "                          ##   ##  "}, {',', "                     ##    #   #   "},
+    {'-', "               #####               "}, {':', "      ##   ##        ##   ##       "},
+    {'(', "   #   #   #    #    #     #     # "}, {')', " #     #     #    #    #   #   #   "},
+    {'/', "    #   #    #   #   #    #   #    "}, {'%', "##   ##  #   #   #   #   #  ##   ##"},
+    {'=', "          #####     #####          "}, {'_', "                              #####"},
+    {'+', "       #    #  #####  #    #       "}, {'<', "   #   #   #   #     #     #     # "},
+    {'>', " #     #     #     #   #   #   #   "},
+};
+
+const char* glyphRows(char c) {
+    c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    for (const Glyph& g : kFont)
+        if (g.c == c) return g.rows;
+    return nullptr;
+}
+
+}  // namespace
+
+std::vector<float> angularErrors(const EvalBuffer& ref, const EvalBuffer& test) {
+    checkSameSize(ref, test);
+    std::vector<float> e(ref.pixelCount(), -1.0f);
+    for (size_t i = 0; i < e.size(); ++i) {
+        if (!ref.covered(i) || !test.covered(i)) continue;
+        glm::vec3 a = ref.direction[i], b = test.direction[i];
+        float la = glm::length(a), lb = glm::length(b);
+        double c = la > 0 && lb > 0 ? glm::dot(a / la, b / lb) : -1.0;
+        e[i] = static_cast<float>(std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / M_PI);
+    }
+    return e;
+}
+
+double ssim(const std::vector<float>& a, const std::vector<float>& b, int w, int h) {
+    // Gaussian window 11x11, sigma 1.5, normalized (Wang et al. 2004), separable.
+    constexpr int R = 5;
+    float g[2 * R + 1], sum = 0;
+    for (int k = -R; k <= R; ++k) sum += g[k + R] = std::exp(-(k * k) / (2.0f * 1.5f * 1.5f));
+    for (float& x : g) x /= sum;
+    const double C1 = 0.01 * 0.01, C2 = 0.03 * 0.03;  // (K L)^2 with L = 1
+    const size_t n = static_cast<size_t>(w) * h;
+    // Five blurred images: mu_a, mu_b, E[a^2], E[b^2], E[ab]; rows first, then columns, over
+    // the windows that lie inside the image ('valid').
+    if (w < 2 * R + 1 || h < 2 * R + 1) return 1.0;
+    std::vector<float> src[5];
+    for (auto& s : src) s.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+        src[0][i] = a[i], src[1][i] = b[i];
+        src[2][i] = a[i] * a[i], src[3][i] = b[i] * b[i], src[4][i] = a[i] * b[i];
+    }
+    const int vw = w - 2 * R, vh = h - 2 * R;
+    std::vector<double> blur[5];
+    for (int k = 0; k < 5; ++k) {
+        std::vector<double> rows(static_cast<size_t>(vw) * h);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < vw; ++x) {
+                double s = 0;
+                for (int j = 0; j <= 2 * R; ++j) s += g[j] * src[k][static_cast<size_t>(y) * w + x + j];
+                rows[static_cast<size_t>(y) * vw + x] = s;
+            }
+        blur[k].resize(static_cast<size_t>(vw) * vh);
+        for (int y = 0; y < vh; ++y)
+            for (int x = 0; x < vw; ++x) {
+                double s = 0;
+                for (int j = 0; j <= 2 * R; ++j) s += g[j] * rows[static_cast<size_t>(y + j) * vw + x];
+                blur[k][static_cast<size_t>(y) * vw + x] = s;
+            }
+    }
+    double total = 0;
+    for (size_t i = 0; i < blur[0].size(); ++i) {
+        double ma = blur[0][i], mb = blur[1][i];
+        double va = blur[2][i] - ma * ma, vb = blur[3][i] - mb * mb, cov = blur[4][i] - ma * mb;
+        total += ((2 * ma * mb + C1) * (2 * cov + C2)) / ((ma * ma + mb * mb + C1) * (va + vb + C2));
+    }
+    return total / blur[0].size();
+}
+
+nlohmann::json compareImages(const EvalBuffer& ref, const EvalBuffer& test, float exposure) {
+    checkSameSize(ref, test);
+    const std::vector<float> e = angularErrors(ref, test);
+    std::vector<double> angles;
+    size_t cr = 0, ct = 0, both = 0, refOnly = 0, testOnly = 0;
+    double se = 0;
+    std::vector<float> la(ref.pixelCount()), lb(ref.pixelCount());
+    for (size_t i = 0; i < e.size(); ++i) {
+        const bool a = ref.covered(i), b = test.covered(i);
+        cr += a, ct += b, both += a && b, refOnly += a && !b, testOnly += b && !a;
+        if (e[i] >= 0) angles.push_back(e[i]);
+        glm::vec3 x = toneMappedPixel(ref, i, exposure), y = toneMappedPixel(test, i, exposure);
+        glm::vec3 d = x - y;
+        se += glm::dot(d, d);
+        la[i] = luminance(x), lb[i] = luminance(y);
+    }
+    const double mse = se / (3.0 * std::max<size_t>(1, e.size()));
+    const double psnr = mse > 0 ? 10.0 * std::log10(1.0 / mse) : 99.0;  // 99: identical
+    return {{"width", ref.width},
+            {"height", ref.height},
+            {"angleDeg", errorStats(angles)},
+            {"coverage",
+             {{"ref", cr}, {"test", ct}, {"both", both}, {"refOnly", refOnly},
+              {"testOnly", testOnly}, {"mismatch", refOnly + testOnly}}},
+            {"psnr", psnr},
+            {"ssim", ssim(la, lb, ref.width, ref.height)}};
+}
+
+glm::u8vec3 errorColor(float degrees, float maxDegrees) {
+    static const glm::vec3 stops[5] = {{20, 20, 120}, {0, 120, 255}, {0, 200, 80}, {255, 220, 0},
+                                       {220, 0, 0}};
+    float t = std::clamp(degrees / maxDegrees, 0.0f, 1.0f) * 4.0f;
+    int k = std::min(3, static_cast<int>(t));
+    glm::vec3 c = glm::mix(stops[k], stops[k + 1], t - k);
+    return glm::u8vec3(glm::round(c));
+}
+
+Image8 toneMapped(const EvalBuffer& b, float exposure) {
+    Image8 img;
+    img.resize(b.width, b.height);
+    for (size_t i = 0; i < b.pixelCount(); ++i) {
+        glm::vec3 c = toneMappedPixel(b, i, exposure);
+        for (int k = 0; k < 3; ++k) img.rgb[3 * i + k] = static_cast<uint8_t>(std::lround(c[k] * 255.0f));
+    }
+    return img;
+}
+
+Image8 heatMap(const EvalBuffer& ref, const EvalBuffer& test, float maxDegrees, float exposure) {
+    const std::vector<float> e = angularErrors(ref, test);
+    const int legend = 24;
+    Image8 img;
+    img.resize(ref.width, ref.height + legend);
+    for (int y = 0; y < ref.height; ++y)
+        for (int x = 0; x < ref.width; ++x) {
+            const size_t i = static_cast<size_t>(y) * ref.width + x;
+            uint8_t* p = img.at(x, y);
+            glm::u8vec3 c;
+            if (e[i] >= 0) c = errorColor(e[i], maxDegrees);
+            else if (ref.covered(i) != test.covered(i)) c = {255, 0, 255};
+            else c = glm::u8vec3(glm::round(toneMappedPixel(ref, i, exposure) * 255.0f * 0.25f));
+            p[0] = c.r, p[1] = c.g, p[2] = c.b;
+        }
+    // Legend: the ramp across the width, labelled at both ends.
+    const int x0 = 4, x1 = std::max(x0 + 1, ref.width - 4);
+    for (int x = x0; x < x1; ++x) {
+        glm::u8vec3 c = errorColor(maxDegrees * (x - x0) / float(x1 - x0 - 1), maxDegrees);
+        for (int y = ref.height + 2; y < ref.height + 10; ++y) {
+            uint8_t* p = img.at(x, y);
+            p[0] = c.r, p[1] = c.g, p[2] = c.b;
+        }
+    }
+    char right[32];
+    std::snprintf(right, sizeof right, "%g DEG", maxDegrees);
+    drawText(img, x0, ref.height + 13, "0", {255, 255, 255}, 1);
+    drawText(img, x1 - 6 * static_cast<int>(std::string(right).size()), ref.height + 13, right,
+             {255, 255, 255}, 1);
+    return img;
+}
+
+void drawText(Image8& image, int x, int y, const std::string& text, glm::u8vec3 color, int scale) {
+    for (size_t k = 0; k < text.size(); ++k) {
+        const char* rows = glyphRows(text[k]);
+        if (!rows) continue;
+        const int gx = x + static_cast<int>(k) * 6 * scale;
+        for (int r = 0; r < 7; ++r)
+            for (int c = 0; c < 5; ++c) {
+                if (rows[r * 5 + c] != '#') continue;
+                for (int dy = 0; dy < scale; ++dy)
+                    for (int dx = 0; dx < scale; ++dx) {
+                        int px = gx + c * scale + dx, py = y + r * scale + dy;
+                        if (px < 0 || py < 0 || px >= image.width || py >= image.height) continue;
+                        uint8_t* p = image.at(px, py);
+                        p[0] = color.r, p[1] = color.g, p[2] = color.b;
+                    }
+            }
+    }
+}
+
+Image8 montage(const std::vector<std::vector<Image8>>& rows,
+               const std::vector<std::vector<std::string>>& labels, int scale) {
+    if (rows.empty() || rows[0].empty()) throw InputError("montage: no images");
+    int tw = 0, cols = 0;
+    for (const auto& row : rows) {
+        cols = std::max(cols, static_cast<int>(row.size()));
+        for (const Image8& t : row) tw = std::max(tw, t.width);
+    }
+    const int gap = 4, band = 7 * scale + 6;
+    std::vector<int> rowH;
+    for (const auto& row : rows) {
+        int h = 0;
+        for (const Image8& t : row) h = std::max(h, t.height);
+        rowH.push_back(h);
+    }
+    int H = gap;
+    for (int h : rowH) H += band + h + gap;
+    Image8 out;
+    out.resize(gap + cols * (tw + gap), H, 24);
+    int y = gap;
+    for (size_t r = 0; r < rows.size(); ++r) {
+        for (size_t c = 0; c < rows[r].size(); ++c) {
+            const Image8& t = rows[r][c];
+            const int x = gap + static_cast<int>(c) * (tw + gap);
+            if (r < labels.size() && c < labels[r].size()) {
+                // Shrink a label that would not fit its tile.
+                const int len = std::max<int>(1, static_cast<int>(labels[r][c].size()));
+                const int s = std::max(1, std::min(scale, (tw - 4) / (6 * len)));
+                drawText(out, x + 2, y + 3 + (7 * scale - 7 * s) / 2, labels[r][c], {240, 240, 240}, s);
+            }
+            for (int ty = 0; ty < t.height; ++ty)
+                std::copy_n(&t.rgb[static_cast<size_t>(ty) * t.width * 3], t.width * 3,
+                            out.at(x, y + band + ty));
+        }
+        y += band + rowH[r] + gap;
+    }
+    return out;
+}
+
+void writePng8(const std::string& path, const Image8& image) {
+    const std::string tmp = path + ".tmp";
+    FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (!f) throw inputError(path, "cannot write");
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+    png_infop info = png ? png_create_info_struct(png) : nullptr;
+    if (!png || !info || setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        std::fclose(f);
+        std::remove(tmp.c_str());
+        throw inputError(path, "libpng failed");
+    }
+    png_init_io(png, f);
+    png_set_IHDR(png, info, image.width, image.height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    png_write_info(png, info);
+    for (int y = 0; y < image.height; ++y)
+        png_write_row(png, const_cast<uint8_t*>(&image.rgb[static_cast<size_t>(y) * image.width * 3]));
+    png_write_end(png, nullptr);
+    png_destroy_write_struct(&png, &info);
+    if (std::fclose(f) != 0 || std::rename(tmp.c_str(), path.c_str()) != 0) {
+        std::remove(tmp.c_str());
+        throw inputError(path, "cannot write");
+    }
+}
+
+}  // namespace shrefract

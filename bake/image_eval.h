@@ -1,0 +1,65 @@
+// Comparing rendered evaluation buffers (common/evalbuffer.h): direction error, coverage, PSNR and
+// SSIM of the tone-mapped images, error heat maps and labelled montages (docs/evaluation.md).
+// Needs no Embree; it lives in bake/ beside the other evaluation code.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "common/evalbuffer.h"
+
+namespace shrefract {
+
+// An 8-bit RGB image, row 0 at the top.
+struct Image8 {
+    int width = 0, height = 0;
+    std::vector<uint8_t> rgb;
+    void resize(int w, int h, uint8_t fill = 0) {
+        width = w, height = h;
+        rgb.assign(static_cast<size_t>(w) * h * 3, fill);
+    }
+    uint8_t* at(int x, int y) { return &rgb[(static_cast<size_t>(y) * width + x) * 3]; }
+};
+
+// Per-pixel angle in degrees between the two direction buffers where both cover the pixel, -1
+// elsewhere.
+std::vector<float> angularErrors(const EvalBuffer& ref, const EvalBuffer& test);
+
+// The report of `shrefract-eval image`: angleDeg {count, mean, median, p95, p99, max} over the
+// pixels both cover; coverage {ref, test, both, refOnly, testOnly, mismatch}; psnr (dB) over
+// all pixels and RGB of toneMapAces(colour) in [0, 1]; ssim: mean SSIM of the tone-mapped
+// luminance (Rec. 709 weights), 11x11 Gaussian window sigma 1.5, K1 0.01, K2 0.03, L 1, over
+// the windows that lie inside the image. Throws InputError if the sizes differ.
+nlohmann::json compareImages(const EvalBuffer& ref, const EvalBuffer& test, float exposure = 1.0f);
+
+// Mean SSIM of two single-channel images in [0, 1] (the definition above); exposed for tests.
+double ssim(const std::vector<float>& a, const std::vector<float>& b, int width, int height);
+
+// The error colour ramp: 0 degrees dark blue through green and yellow to red at maxDegrees
+// (and beyond).
+glm::u8vec3 errorColor(float degrees, float maxDegrees);
+
+// Heat map: covered-by-both pixels coloured by errorColor(error, maxDegrees); coverage mismatch
+// magenta; background (neither) the reference's tone-mapped colour at a quarter brightness; and a
+// legend strip under the image (ramp, "0" ... "30 DEG").
+Image8 heatMap(const EvalBuffer& ref, const EvalBuffer& test, float maxDegrees = 30.0f,
+               float exposure = 1.0f);
+
+// The tone-mapped colour of a buffer.
+Image8 toneMapped(const EvalBuffer& buffer, float exposure = 1.0f);
+
+// Side by side, each tile under a label band (built-in 5x7 font, upper case), like the paper's
+// Figure 11. `rows` of tiles, all of one size; labels[r][c] for tile c of row r.
+Image8 montage(const std::vector<std::vector<Image8>>& rows,
+               const std::vector<std::vector<std::string>>& labels, int scale = 2);
+
+// Draws text (upper-cased; unknown characters as blanks) with its top-left at (x, y).
+void drawText(Image8& image, int x, int y, const std::string& text, glm::u8vec3 color, int scale);
+
+// Writes an 8-bit sRGB PNG via a temporary name; throws InputError naming the file.
+void writePng8(const std::string& path, const Image8& image);
+
+}  // namespace shrefract

@@ -1,0 +1,65 @@
+// The ground-truth renderer (DESIGN.md §5): per pixel, the path the bake would trace, on the CPU
+// with Embree, shaded exactly as the runtime shades (docs/evaluation.md "raytrace").
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "bake/tracer.h"
+#include "common/bakefile.h"
+#include "common/evalbuffer.h"
+#include "common/latlong.h"
+
+namespace shrefract {
+
+// A pinhole camera, the runtime's Camera (runtime/include/shrefract/render.h) and projection:
+// glm::lookAt(eye, target, up) and glm::perspective(fov, width / height), vertical fov.
+struct ReferenceView {
+    glm::vec3 eye{0, 0, 3}, target{0, 0, 0}, up{0, 1, 0};
+    float fovDegrees = 45.0f;
+    int width = 0, height = 0;
+};
+
+// The unit world direction through the centre of pixel (x, y), row 0 at the top: GL samples
+// pixel centres (x + 0.5, y + 0.5) in window space with y up, and the runtime flips rows.
+glm::vec3 primaryRay(const ReferenceView& view, int x, int y);
+
+// The bake's path rules as recorded in its manifest (branch, maxBounces).
+TraceOptions traceOptionsOfBake(const BakeData& bake);
+
+// The environment as the reference looks it up: by default through the runtime's own cube map
+// (the same faces, GL_LINEAR inside a face), else bilinearly in the lat-long image.
+struct ReferenceEnvironment {
+    LatLongImage latLong;
+    CubeMapImage cube;
+    bool viaCubeMap = true;
+    explicit ReferenceEnvironment(LatLongImage image, bool viaCubeMap = true, int faceSize = 0);
+    glm::vec3 operator()(glm::vec3 d) const {
+        return viaCubeMap ? sampleCube(cube, d) : sampleLatLong(latLong, glm::normalize(d));
+    }
+};
+
+struct ReferenceStats {
+    double milliseconds = 0;  // wall time of the whole frame
+    size_t covered = 0;       // pixels whose primary ray hit the object
+    size_t tir = 0, capped = 0, reentered = 0, geometricNormal = 0, backFacing = 0;
+};
+
+// Renders one frame, object at the origin (identity model, as shrefract-render):
+//   primary ray -> first hit (part q, exact mesh) -> n = interpolated shading normal
+//   colour = F * env(reflect) + (1 - F) * env(exit) * exp(-kappa_q * length)
+// with F = FresnelDielectric(n . omega, ior_q), exit and length from tracer.trace(hit, n, omega,
+// q) (omega = -ray direction; if n faces away from the viewer the geometric normal enters
+// instead, as rule 3 does later on the path), env = ReferenceEnvironment. Background pixels
+// show env(ray), coverage 0. Tiles of 16x16 pixels in parallel (TBB).
+EvalBuffer renderReference(const Tracer& tracer, const ReferenceEnvironment& environment,
+                           const ReferenceView& view, ReferenceStats* stats = nullptr);
+
+// d_N of Wyman 2005 per point: the distance from p along the inward normal -n to the next
+// surface of the scene (0 if none), measured between true surface points. Parallel.
+std::vector<float> normalDistances(const Tracer& tracer, const std::vector<glm::vec3>& p,
+                                   const std::vector<glm::vec3>& n);
+
+}  // namespace shrefract

@@ -1,0 +1,66 @@
+// The methods the paper compares with (its Figure 11), in GLSL, for evaluation
+// (docs/evaluation.md): single-sided refraction and Wyman 2005 two-sided image-space refraction.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "shrefract/runtime.h"
+
+namespace shrefract {
+
+enum class BaselineMethod {
+    Single,  // refract once at the front surface, look up the environment
+    Wyman,   // Wyman 2005: second interface from a back-face normal/depth pass
+};
+
+// Wyman's slides list three answers to total internal reflection at the second interface.
+enum class WymanTir {
+    Reflect,   // mirror T1 about the back normal (the bake's rule: TIR reflects); default
+    Straight,  // continue along T1
+    Grazing,   // refract at the critical angle: T1 projected onto the back surface's plane
+};
+
+struct BaselineOptions {
+    BaselineMethod method = BaselineMethod::Wyman;
+    WymanTir tir = WymanTir::Reflect;
+    bool timings = true;                     // GL timer queries around each pass
+    void* (*loader)(const char*) = nullptr;  // GL function loader; nullptr: guess from context
+};
+
+// GPU time per pass of the last draw(), milliseconds.
+struct BaselineTimings {
+    double backFaces = 0;  // Wyman pass 1: back-face normals and depth (0 for single)
+    double shade = 0;      // the front-surface pass
+};
+
+class Baseline {
+public:
+    // Uploads the bake's mesh (its layout's triangle corners) in the current context. Wyman needs
+    // d_N, the distance along the inward normal to the far side, per bake sample (only triangle
+    // corners are read): compute it by ray casting, e.g. bake/reference.h normalDistances().
+    static std::unique_ptr<Baseline> create(const Bake& bake, const std::vector<float>& normalDistance,
+                                            const BaselineOptions& options = {});
+    ~Baseline();
+    // Shades the object into the bound framebuffer (draw buffer 0: linear HDR colour; draw
+    // buffer 1: world exit direction + coverage 1), like Refractor::draw. The back-face buffer
+    // has the size of the current viewport.
+    void draw(const glm::mat4& view, const glm::mat4& projection, const glm::mat4& model,
+              const Environment& environment);
+    const BaselineTimings& timings() const;
+
+    struct Impl;
+
+private:
+    explicit Baseline(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
+};
+
+// "single" | "wyman", "reflect" | "straight" | "grazing"; throw std::invalid_argument otherwise.
+BaselineMethod parseBaselineMethod(const std::string& text);
+WymanTir parseWymanTir(const std::string& text);
+
+}  // namespace shrefract

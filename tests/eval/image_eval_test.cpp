@@ -1,0 +1,105 @@
+// Image metrics, the evaluation EXR layout and the reference camera, against known answers.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <random>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "bake/image_eval.h"
+#include "bake/reference.h"
+#include "common/evalbuffer.h"
+#include "common/latlong.h"
+
+using namespace shrefract;
+
+namespace {
+
+EvalBuffer randomBuffer(int w, int h, unsigned seed) {
+    EvalBuffer b;
+    b.width = w, b.height = h;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    for (int i = 0; i < w * h; ++i) {
+        b.color.emplace_back(u(rng) + 1, u(rng) + 1, u(rng) + 1, i % 3 ? 1.0f : 0.0f);
+        b.direction.push_back(i % 3 ? glm::normalize(glm::vec3(u(rng), u(rng), u(rng))) : glm::vec3(0));
+    }
+    return b;
+}
+
+}  // namespace
+
+TEST(ImageEval, EvalBufferRoundTripsThroughExr) {
+    std::filesystem::create_directories(SHREFRACT_TEST_TMP);
+    const std::string path = std::string(SHREFRACT_TEST_TMP) + "/roundtrip.exr";
+    EvalBuffer a = randomBuffer(17, 9, 3);
+    writeEvalBuffer(path, a);
+    EvalBuffer b = readEvalBuffer(path);
+    ASSERT_EQ(b.width, 17);
+    ASSERT_EQ(b.height, 9);
+    for (size_t i = 0; i < a.pixelCount(); ++i) {
+        EXPECT_EQ(a.color[i], b.color[i]) << i;
+        EXPECT_EQ(a.direction[i], b.direction[i]) << i;
+    }
+}
+
+TEST(ImageEval, IdenticalImagesHaveZeroErrorAndSsimOne) {
+    EvalBuffer a = randomBuffer(32, 24, 5);
+    nlohmann::json r = compareImages(a, a);
+    EXPECT_NEAR(r["angleDeg"]["max"].get<double>(), 0.0, 0.05);  // acos near 1 is ill-conditioned
+    EXPECT_EQ(r["coverage"]["mismatch"].get<size_t>(), 0u);
+    EXPECT_NEAR(r["ssim"].get<double>(), 1.0, 1e-9);
+    EXPECT_EQ(r["psnr"].get<double>(), 99.0);
+}
+
+TEST(ImageEval, KnownAngleAndCoverageMismatch) {
+    EvalBuffer a = randomBuffer(16, 16, 1), b = a;
+    for (size_t i = 0; i < a.pixelCount(); ++i)
+        if (a.covered(i)) a.direction[i] = {0, 0, 1}, b.direction[i] = {0, std::sin(0.1f), std::cos(0.1f)};
+    b.color[1].a = 0.0f;  // covered in a only
+    nlohmann::json r = compareImages(a, b);
+    EXPECT_NEAR(r["angleDeg"]["median"].get<double>(), 0.1 * 180 / M_PI, 1e-3);
+    EXPECT_EQ(r["coverage"]["refOnly"].get<size_t>(), 1u);
+    EXPECT_EQ(r["coverage"]["testOnly"].get<size_t>(), 0u);
+}
+
+TEST(ImageEval, SsimDropsWithNoiseAndIsSymmetric) {
+    const int w = 40, h = 30;
+    std::vector<float> a(w * h), b(w * h);
+    std::mt19937 rng(9);
+    std::normal_distribution<float> n(0.0f, 0.2f);
+    for (int i = 0; i < w * h; ++i) a[i] = 0.5f + 0.3f * std::sin(i * 0.1f), b[i] = a[i] + n(rng);
+    double s = ssim(a, b, w, h);
+    EXPECT_LT(s, 0.9);
+    EXPECT_GT(s, 0.0);
+    EXPECT_NEAR(s, ssim(b, a, w, h), 1e-12);
+}
+
+// The reference camera is glm's: the ray through a pixel centre projects back onto it.
+TEST(Reference, PrimaryRayHitsThePixelCentreUnderTheGlProjection) {
+    ReferenceView v;
+    v.eye = {1.0f, 0.7f, 2.5f}, v.target = {0.1f, -0.2f, 0.0f}, v.fovDegrees = 40.0f;
+    v.width = 64, v.height = 48;
+    const glm::mat4 vp = glm::perspective(glm::radians(v.fovDegrees), 64.0f / 48.0f, 0.01f, 1000.0f) *
+                         glm::lookAt(v.eye, v.target, v.up);
+    for (glm::ivec2 px : {glm::ivec2(0, 0), glm::ivec2(63, 47), glm::ivec2(10, 30), glm::ivec2(32, 24)}) {
+        glm::vec4 c = vp * glm::vec4(v.eye + 2.0f * primaryRay(v, px.x, px.y), 1.0f);
+        // GL window coordinates: y up; the renderers store row 0 at the top.
+        float wx = (c.x / c.w * 0.5f + 0.5f) * v.width, wy = (c.y / c.w * 0.5f + 0.5f) * v.height;
+        EXPECT_NEAR(wx, px.x + 0.5f, 1e-3f);
+        EXPECT_NEAR(v.height - wy, px.y + 0.5f, 1e-3f);
+    }
+}
+
+TEST(LatLong, BilinearLookupMatchesTexelCentres) {
+    // 4 x 2 image, texel (x, y) = x + 10 y: at a texel centre the lookup returns that texel.
+    LatLongImage img;
+    img.width = 4, img.height = 2;
+    for (int y = 0; y < 2; ++y)
+        for (int x = 0; x < 4; ++x)
+            for (int c = 0; c < 3; ++c) img.rgb.push_back(float(x + 10 * y));
+    // Texel (1, 0): u = 1.5 / 4, v = 0.5 / 2 -> phi = 2 pi (u - 0.5), theta = pi v.
+    float phi = 2.0f * float(M_PI) * (1.5f / 4 - 0.5f), theta = float(M_PI) * 0.25f;
+    glm::vec3 d(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
+    EXPECT_NEAR(sampleLatLong(img, d).x, 1.0f, 1e-4f);
+}

@@ -61,9 +61,10 @@ enum class ShForm {
 // samples x 4 channels; docs/runtime.md "Polynomial vs recurrence"):
 //   order 8: polynomial 1.5e-5, recurrence 5.9e-6 (2.5x)    order 11: 6.3e-5 vs 1.3e-5 (5x)
 //   order 12: 2.9e-4 vs 1.7e-5 (18x)    order 16: 8.9e-3 vs 3.1e-5 (290x)    20: 0.34 vs 6.0e-5
-// Below 12 both are ~1e-5 or less, and on llvmpipe the recurrence costs 1-3x the polynomial's
-// time (0.97 vs 1.17 ms at order 8, 1.2 vs 2.6 ms at 12, 2.4 vs 7.4 ms at 16), although its
-// estimated ALU is 2-3x lower; under the "2006" limits it needs about half the passes.
+// Below 12 both are ~1e-5 or less, and on llvmpipe the recurrence takes 1.1-3x the polynomial's
+// time (ms polynomial / recurrence, two runs: order 8 1.0 / 1.2-2.3, 12 1.2-2.8 / 2.6-5.4,
+// 16 2.4-3.5 / 6.7-7.4), although its estimated ALU is 2-3x lower; under the "2006" limits it
+// needs about half the passes.
 constexpr int kRecurrenceFromOrder = 12;
 
 const char* ToString(ShForm form);

@@ -79,6 +79,7 @@ struct Refractor::Impl {
     bool smoothing = false, correction = true;
     int muW = 0, muH = 0, rhoW = 0, rhoH = 0, listWidth = 1;
     ShaderLimits limits;
+    ShForm form = ShForm::Auto;
     struct Compiled {
         DecompressionShaders shaders;
         std::vector<GLuint> programs;
@@ -117,7 +118,7 @@ const Refractor::Impl::Compiled& Refractor::Impl::compiledFor(int L) {
     auto it = compiled.find(L);
     if (it != compiled.end()) return it->second;
     Compiled c;
-    c.shaders = generateDecompression(L, limits);
+    c.shaders = generateDecompression(L, limits, form);
     for (size_t i = 0; i < c.shaders.passes.size(); ++i) {
         const DecompressionPass& pass = c.shaders.passes[i];
         GLuint p = buildProgram(c.shaders.vertex, pass.fragment,
@@ -164,6 +165,7 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
     GLint units = 16;
     glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &units);
     m->limits = shaderPreset(options.preset, units);
+    m->form = parseShForm(options.form);
 
     // Samples (P, N) and weights, mu layout.
     m->positionTex = makeTexture2D(GL_RGB32F, m->muW, m->muH, GL_RGB, GL_FLOAT,
@@ -180,6 +182,13 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
     m->memory.rho = static_cast<size_t>(m->rhoW) * m->rhoH * 16;  // RGBA32UI
     std::vector<float> padded(layer, 0.0f);
     if (m->limits.weightArray) {
+        // GL 3.3 guarantees 256 layers (order 20 needs 231); llvmpipe allows 2048.
+        GLint maxLayers = 256;
+        glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &maxLayers);
+        if (K > maxLayers)
+            throw std::runtime_error("shrefract: order " + std::to_string(m->maxOrder) + " needs " +
+                                     std::to_string(K) + " weight layers, GL allows " +
+                                     std::to_string(maxLayers) + " (set maxOrder lower)");
         glGenTextures(1, &m->weightArray);
         glBindTexture(GL_TEXTURE_2D_ARRAY, m->weightArray);
         glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA32F, m->muW, m->muH, K, 0, GL_RGBA, GL_FLOAT,
@@ -464,6 +473,10 @@ int Refractor::passCount() const {
     return static_cast<int>(impl_->compiledFor(impl_->order).programs.size());
 }
 
+std::string Refractor::form() const {
+    return ToString(impl_->compiledFor(impl_->order).shaders.form);
+}
+
 void Refractor::dumpShaders(const std::string& dir) const {
     impl_->use();
     shrefract::dumpShaders(impl_->compiledFor(impl_->order).shaders, dir);
@@ -481,6 +494,13 @@ static std::vector<float> readTexture(GLuint texture, int w, int h) {
 std::vector<float> Refractor::readDirectionalMap() const {
     impl_->use();
     std::vector<float> all = readTexture(impl_->lastD, impl_->muW, impl_->muH);
+    all.resize(static_cast<size_t>(impl_->bake.sampleCount()) * 4);
+    return all;
+}
+
+std::vector<float> Refractor::readLocalViewMap() const {
+    impl_->use();
+    std::vector<float> all = readTexture(impl_->localView.texture, impl_->muW, impl_->muH);
     all.resize(static_cast<size_t>(impl_->bake.sampleCount()) * 4);
     return all;
 }

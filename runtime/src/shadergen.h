@@ -13,6 +13,20 @@
 //  - each pass costs 1 more for its output.
 // Texture units per pass: the local-view texture, the partial sum (every pass but the first),
 // and one unit per weight texture, or a single unit for all when weights are a 2D array.
+//
+// A second form, ShForm::Recurrence, evaluates the same functions by the normalized associated
+// Legendre recurrence instead (common/sh.cpp's shEvalEven, unrolled): better in float32 at high
+// orders, where the expanded polynomials lose ~log10(absSum) digits to cancellation. Its cost
+// model (same units):
+//  - (x + iy)^m = re_m + i im_m by repeated complex multiplication: 4 per m >= 2 (m = 0, 1 free);
+//  - column m, Q_l^m = Pbar_l^m / s^m for l = m..top (all l, odd parity too, as intermediates):
+//    Q_m^m a literal (free), Q_{m+1}^m = literal * z costs 1, each further l costs 3
+//    (a (z Q_{l-1} - b Q_{l-2}): MUL, MAD, MUL);
+//  - a function: m = 0 accumulates Q_l^0 (1); m != 0 multiplies by re_m or im_m (1) and
+//    accumulates (1);
+//  - each pass costs 1 more for its output.
+// A pass computes the powers through its largest |m| and each column through its largest l, so
+// a function's marginal cost is what its power and column add to what the pass already has.
 #pragma once
 
 #include <string>
@@ -34,6 +48,31 @@ struct ShaderLimits {
 // Throws std::invalid_argument for other names.
 ShaderLimits shaderPreset(const std::string& name, int maxTextureUnits = 16);
 
+// How each SH function is evaluated in GLSL.
+enum class ShForm {
+    Polynomial,  // expanded Cartesian polynomial, exact integer coefficients x scale (paper §5.1)
+    Recurrence,  // associated Legendre recurrence with (x + iy)^m, float32 throughout
+    Auto,        // Recurrence from order kRecurrenceFromOrder on, Polynomial below it
+};
+
+// The order from which ShForm::Auto uses the recurrence: the first order where the polynomial's
+// float32 error is 10x the recurrence's or more. Measured (scripts/bench-shforms, llvmpipe,
+// octahedron bake, weights uniform in [-1, 1], max |GL - double reference| over 4 views x ~1k
+// samples x 4 channels; docs/runtime.md "Polynomial vs recurrence"):
+//   order 8: polynomial 1.5e-5, recurrence 5.9e-6 (2.5x)    order 11: 6.3e-5 vs 1.3e-5 (5x)
+//   order 12: 2.9e-4 vs 1.7e-5 (18x)    order 16: 8.9e-3 vs 3.1e-5 (290x)    20: 0.34 vs 6.0e-5
+// Below 12 both are ~1e-5 or less, and on llvmpipe the recurrence takes 1.1-3x the polynomial's
+// time (ms polynomial / recurrence, two runs: order 8 1.0 / 1.2-2.3, 12 1.2-2.8 / 2.6-5.4,
+// 16 2.4-3.5 / 6.7-7.4), although its estimated ALU is 2-3x lower; under the "2006" limits it
+// needs about half the passes.
+constexpr int kRecurrenceFromOrder = 12;
+
+const char* ToString(ShForm form);
+// "polynomial" | "recurrence" | "auto"; throws std::invalid_argument for anything else.
+ShForm parseShForm(const std::string& name);
+// What `form` means at `order` (Auto resolved; the others unchanged).
+ShForm resolveShForm(ShForm form, int order);
+
 // What a sampler uniform of a pass binds.
 struct SamplerBinding {
     enum Kind { LocalView, PartialSum, Weight, WeightArray } kind;
@@ -51,17 +90,22 @@ struct DecompressionPass {
 struct DecompressionShaders {
     int order = 0;
     ShaderLimits limits;
+    ShForm form = ShForm::Polynomial;  // the form generated (never Auto)
     std::string vertex;  // full-screen triangle from gl_VertexID
     std::vector<DecompressionPass> passes;
-    // "order 8, limits 2006: 7 passes (ALU 63 61 ..., units 16 16 ...)"
+    // "order 8, limits 2006: 7 passes (ALU 63 61 ...; units 16 16 ...)", plus ", recurrence"
+    // for that form
     std::string summary() const;
 };
 
-// Expands y_k for the shEvenCount(order) stored functions and distributes them into passes:
-// first-fit decreasing by standalone cost, each candidate charged its marginal cost (monomials
-// the pass already has are free). Throws std::invalid_argument when one function alone exceeds
-// the limits.
-DecompressionShaders generateDecompression(int order, const ShaderLimits& limits);
+// Generates y_k for the shEvenCount(order) stored functions in `form` and distributes them into
+// passes: first-fit decreasing by standalone cost, each candidate charged its marginal cost
+// (monomials, powers and column entries the pass already has are free). Throws
+// std::invalid_argument when one function alone exceeds the limits. Auto falls back to the
+// polynomial form where the recurrence does not fit the limits (the "2006" preset above order
+// 16: y_L^L alone needs the powers (x + iy)^2..L, 4 (L - 1) + 3 > 64 ALU).
+DecompressionShaders generateDecompression(int order, const ShaderLimits& limits,
+                                           ShForm form = ShForm::Auto);
 
 // Writes decompress.vert, decompress_passN.frag and passes.txt into `dir` (created); throws
 // std::runtime_error naming the file on failure.

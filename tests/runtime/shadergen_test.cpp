@@ -28,10 +28,12 @@ std::string concatenated(const DecompressionShaders& s) {
 }
 
 TEST(ShaderGen, EveryFunctionOnceAndWithinLimits) {
+    for (ShForm form : {ShForm::Polynomial, ShForm::Recurrence})
     for (const char* preset : {"2006", "modern"}) {
         for (int L = 0; L <= 10; ++L) {
             ShaderLimits limits = shaderPreset(preset);
-            DecompressionShaders s = generateDecompression(L, limits);
+            DecompressionShaders s = generateDecompression(L, limits, form);
+            EXPECT_EQ(s.form, form);
             std::multiset<int> seen;
             for (size_t p = 0; p < s.passes.size(); ++p) {
                 const DecompressionPass& pass = s.passes[p];
@@ -67,14 +69,15 @@ TEST(ShaderGen, GeneratedGlslCompiles) {
         GTEST_SKIP() << "glslangValidator not found (Debian: glslang-tools)";
     namespace fs = std::filesystem;
     fs::path dir = fs::path(SHREFRACT_TEST_TMP) / "glsl";
+    for (ShForm form : {ShForm::Polynomial, ShForm::Recurrence})
     for (const char* version : {"330 core", "450"})
         for (const char* preset : {"2006", "modern"})
             for (int L : {0, 2, 5, 8}) {
                 ShaderLimits limits = shaderPreset(preset);
                 limits.version = version;
-                DecompressionShaders s = generateDecompression(L, limits);
+                DecompressionShaders s = generateDecompression(L, limits, form);
                 fs::path sub = dir / (std::string(preset) + "_" + std::to_string(L) + "_" +
-                                      std::string(version).substr(0, 3));
+                                      std::string(version).substr(0, 3) + "_" + ToString(form));
                 dumpShaders(s, sub.string());
                 std::vector<std::string> files = {(sub / "decompress.vert").string()};
                 for (size_t i = 0; i < s.passes.size(); ++i)

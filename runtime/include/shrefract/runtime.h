@@ -86,6 +86,13 @@ struct GpuMemory {
 
 struct RefractorOptions {
     std::string preset = "modern";  // shader limits: "modern" or "2006" (runtime/src/shadergen.h)
+    // How the generated passes evaluate the SH functions: "polynomial" (expanded Cartesian
+    // polynomials, the paper's), "recurrence" (associated Legendre recurrence: fewer float32
+    // digits lost at high orders) or "auto" (the recurrence from the measured switch order on;
+    // docs/runtime.md "Polynomial vs recurrence"). Where the recurrence does not fit the
+    // preset's limits ("2006" above order 16), "auto" uses the polynomial and "recurrence"
+    // throws std::invalid_argument.
+    std::string form = "auto";
     int order = -1;                 // SH order used, -1: all stored
     int maxOrder = -1;              // bands uploaded to the GPU, 0..maxOrder (-1: all stored);
                                     // setOrder() cannot go above it
@@ -119,11 +126,16 @@ public:
     void setTimings(bool on);
     const Timings& timings() const;
     int passCount() const;  // decompression passes at the current order
+    // The SH evaluation form of the current order's passes: "polynomial" or "recurrence".
+    std::string form() const;
     const GpuMemory& memory() const;
     // Writes the generated GLSL of the current order into `dir`.
     void dumpShaders(const std::string& dir) const;
     // Reads back D_mu after update() (smoothed if on): 4 floats per sample, sample order.
     std::vector<float> readDirectionalMap() const;
+    // Reads back the local view direction per sample after update() (4 floats per sample, xyz
+    // used): what the decompression passes evaluated the SH at, for precision measurements.
+    std::vector<float> readLocalViewMap() const;
     // Reads back the refraction map, rho layout, RGBA row-major from row 0.
     std::vector<float> readRefractionMap() const;
 

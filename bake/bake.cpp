@@ -55,7 +55,8 @@ BakeResult bake(const Scene& scene, const BakeOptions& opt, const std::string& i
 
     // W = M R: the compression matrix in float for the GEMM, with the band filter folded into
     // its rows (filtering the weights equals filtering M's rows: diag(h) (M R) = (diag(h) M) R).
-    Eigen::MatrixXd Md = compressionMatrixCached(opt.grid, opt.order, opt.cacheDir);
+    Eigen::MatrixXd Md = opt.leastSquares ? leastSquaresMatrix(opt.grid, opt.order)
+                                          : compressionMatrixCached(opt.grid, opt.order, opt.cacheDir);
     std::vector<double> h = shBandFilter(opt.order, opt.filterWidth);
     std::vector<int> band = evenBands(opt.order);
     for (int k = 0; k < K; ++k) Md.row(k) *= h[band[k]];
@@ -151,6 +152,7 @@ BakeResult bake(const Scene& scene, const BakeOptions& opt, const std::string& i
         {"input", ec ? inputPath : abs.string()},
         {"grid", {opt.grid.nTheta, opt.grid.nPhi}},
         {"filterWidth", opt.filterWidth},
+        {"fit", opt.leastSquares ? "least-squares" : "projection"},
         {"branch", opt.trace.branch == Branch::Fresnel ? "fresnel" : "transmit"},
         {"maxBounces", opt.trace.maxBounces},
         {"media", media},

@@ -27,6 +27,7 @@ struct BakeOptions {
     DirectionGrid grid;      // 32 x 64 = 2048 directions, the paper's count
     TraceOptions trace;
     double filterWidth = 0.0;  // semi-Gaussian width in bands; <= 0: none
+    bool leastSquares = false; // fit by weighted least squares instead of projecting through M
     Precision precision = Precision::F32;
     int threads = 0;         // 0: all cores
     std::string cacheDir;    // compression matrix cache; empty: none

@@ -9,6 +9,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "common/optics.h"
 
@@ -128,32 +129,31 @@ bool Tracer::intersect(glm::vec3 org, glm::vec3 dir, float* t) const {
     return rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
 }
 
-bool Tracer::hit(glm::vec3 org, glm::vec3 dir, SurfaceHit* out) const {
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    RTCRayHit rh;
-    rh.ray.org_x = org.x, rh.ray.org_y = org.y, rh.ray.org_z = org.z;
-    rh.ray.dir_x = dir.x, rh.ray.dir_y = dir.y, rh.ray.dir_z = dir.z;
-    rh.ray.tnear = 0.0f;
-    rh.ray.tfar = std::numeric_limits<float>::infinity();
-    rh.ray.mask = 0xFFFFFFFF;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(rtc_->scene, &ctx, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-    // The same surface point and normals as trace() computes at its hits.
+// The surface point and normals at an Embree hit, as trace() uses them.
+SurfaceHit Tracer::surfaceAt(const ::RTCRayHit& rh) const {
     const Mesh& m = scene_.parts[rh.hit.geomID].mesh;
     const glm::uvec3 tri = m.triangles[rh.hit.primID];
     const float u = rh.hit.u, v = rh.hit.v, w = 1.0f - u - v;
-    out->t = rh.ray.tfar;
-    out->part = rh.hit.geomID;
-    out->triangle = rh.hit.primID;
-    out->p = w * m.positions[tri[0]] + u * m.positions[tri[1]] + v * m.positions[tri[2]];
-    out->ng = glm::normalize(glm::cross(m.positions[tri[1]] - m.positions[tri[0]],
-                                        m.positions[tri[2]] - m.positions[tri[0]]));
+    SurfaceHit out;
+    out.t = rh.ray.tfar;
+    out.part = rh.hit.geomID;
+    out.triangle = rh.hit.primID;
+    // Barycentric, not org + t dir: the point lies on the triangle to float precision.
+    out.p = w * m.positions[tri[0]] + u * m.positions[tri[1]] + v * m.positions[tri[2]];
+    // Embree's Ng is the counter-clockwise (outward) normal, unnormalized.
+    out.ng = glm::normalize(glm::vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
     glm::vec3 ns = w * m.normals[tri[0]] + u * m.normals[tri[1]] + v * m.normals[tri[2]];
     float len = glm::length(ns);
-    out->ns = len > 0 ? ns / len : out->ng;
+    out.ns = len > 0 ? ns / len : out.ng;
+    return out;
+}
+
+bool Tracer::hit(glm::vec3 org, glm::vec3 dir, SurfaceHit* out) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh = closestHit(rtc_->scene, &ctx, org, dir);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    *out = surfaceAt(rh);
     return true;
 }
 
@@ -192,16 +192,9 @@ PathResult Tracer::trace(glm::vec3 p, glm::vec3 n, glm::vec3 omega, uint32_t par
             res.exit = d;
             return res;
         }
-        const uint32_t q = rh.hit.geomID;
-        const Mesh& m = s.parts[q].mesh;
-        const glm::uvec3 tri = m.triangles[rh.hit.primID];
-        const float u = rh.hit.u, v = rh.hit.v, w = 1.0f - u - v;
-        const glm::vec3 hitP = w * m.positions[tri[0]] + u * m.positions[tri[1]] + v * m.positions[tri[2]];
-        glm::vec3 ng = glm::normalize(glm::cross(m.positions[tri[1]] - m.positions[tri[0]],
-                                                 m.positions[tri[2]] - m.positions[tri[0]]));
-        glm::vec3 ns = w * m.normals[tri[0]] + u * m.normals[tri[1]] + v * m.normals[tri[2]];
-        float nsLen = glm::length(ns);
-        ns = nsLen > 0 ? ns / nsLen : ng;
+        const SurfaceHit h = surfaceAt(rh);
+        const uint32_t q = h.part;
+        const glm::vec3 hitP = h.p, ng = h.ng, ns = h.ns;
         // Rule 6: length inside non-air media.
         if (before >= 0) res.length += glm::length(hitP - from);
         from = hitP;
@@ -242,13 +235,12 @@ PathResult Tracer::trace(glm::vec3 p, glm::vec3 n, glm::vec3 omega, uint32_t par
             res.flags |= kPathTIR;
         } else if (options_.branch == Branch::Transmit) {
             reflect = false;
-        } else if (res.bounces >= cap / 2) {
+        } else {
+            const bool larger = FresnelDielectric(glm::dot(wi, nf), eta) > 0.5f;
             // Rule 5: past half the cap, take the transmitted branch whenever it exists, so
             // every path ends deterministically.
-            reflect = false;
-            if (FresnelDielectric(glm::dot(wi, nf), eta) > 0.5f) res.flags |= kPathSoftCapped;
-        } else {
-            reflect = FresnelDielectric(glm::dot(wi, nf), eta) > 0.5f;  // the larger branch
+            reflect = larger && res.bounces < cap / 2;  // else the larger branch
+            if (larger && !reflect) res.flags |= kPathSoftCapped;
         }
         if (reflect) {
             d = Reflect(wi, nf);

@@ -9,6 +9,8 @@
 
 #include "common/scene.h"
 
+struct RTCRayHit;  // embree3/rtcore_ray.h
+
 namespace shrefract {
 
 enum class Branch { Fresnel, Transmit };
@@ -76,6 +78,7 @@ public:
 
 private:
     struct Embree;
+    SurfaceHit surfaceAt(const ::RTCRayHit& rh) const;
     const Scene& scene_;
     TraceOptions options_;
     std::unique_ptr<Embree> rtc_;

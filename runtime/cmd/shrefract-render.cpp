@@ -56,7 +56,7 @@ std::vector<float> parseFloats(const std::string& text, size_t count, const std:
 int main(int argc, char** argv) {
     CLI::App app{"Render a shrefract bake (interactive refraction, Genevaux et al. 2006) headless"};
     std::string bakePath, envPath, camera, eye, target, size = "1024x1024", backend = "egl";
-    std::string out, outExr, dirs, dumpDir, preset = "modern";
+    std::string out, outExr, dirs, dumpDir, preset = "modern", form = "auto";
     float fov = 45.0f, exposure = 1.0f;
     int order = -1, frames = 5;
     bool smoothing = false;
@@ -72,6 +72,8 @@ int main(int argc, char** argv) {
     app.add_option("--order", order, "SH order used at runtime (default: all stored)");
     app.add_option("--backend", backend, "headless GL: egl | osmesa")->capture_default_str();
     app.add_option("--preset", preset, "shader limits: modern | 2006")->capture_default_str();
+    app.add_option("--form", form, "SH evaluation in GLSL: auto | polynomial | recurrence")
+        ->capture_default_str()->check(CLI::IsMember({"auto", "polynomial", "recurrence"}));
     app.add_option("--frames", frames, "frames timed after a warm-up one")->capture_default_str();
     app.add_flag("--smooth", smoothing, "spatial smoothing through the neighbour lists");
     app.add_option("--exposure", exposure, "exposure before the tone map")->capture_default_str();
@@ -177,6 +179,7 @@ int main(int argc, char** argv) {
             if (method == "sh") {
                 shrefract::RefractorOptions options;
                 options.preset = preset;
+                options.form = form;
                 options.order = order;
                 options.smoothing = smoothing;
                 options.loader = context->loader();

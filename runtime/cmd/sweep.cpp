@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 
 #include "bake/bake.h"
 #include "bake/image_eval.h"
@@ -222,7 +223,7 @@ int main(int argc, char** argv) {
                     }
                 }
                 // The 2006 multipass preset, and the two SH forms, at order 8 and the top order.
-                for (int L : {8, Lmax}) {
+                for (int L : std::set<int>{8, Lmax}) {
                     for (const char* preset : {"2006", "modern"})
                         for (const char* form : {"polynomial", "recurrence"}) {
                             RefractorOptions o;

@@ -47,6 +47,10 @@ int main(int argc, char** argv) {
     app.add_option("--max-bounces", opt.trace.maxBounces, "bounce cap per path")->capture_default_str()->check(CLI::Range(1, 10000));
     app.add_option("--filter", opt.filterWidth, "semi-Gaussian SH low-pass width in bands (0: none)")
         ->capture_default_str()->check(CLI::Range(0.0, 1000.0));
+    std::string fit = "projection";
+    app.add_option("--fit", fit, "projection: W = M R through the compression matrix; lsq: "
+                                 "weighted least squares on the grid samples")
+        ->capture_default_str()->check(CLI::IsMember({"projection", "lsq"}));
     app.add_option("--precision", precision, "weight storage: f32, f16 or u8")->capture_default_str()
         ->check(CLI::IsMember({"f32", "f16", "u8"}));
     app.add_option("--threads", opt.threads, "worker threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
@@ -65,6 +69,7 @@ int main(int argc, char** argv) {
         opt.grid = parseGrid(grid, "--grid");
         opt.trace.branch = branch == "transmit" ? Branch::Transmit : Branch::Fresnel;
         opt.precision = parsePrecision(precision);
+        opt.leastSquares = fit == "lsq";
         opt.cacheDir = cache;
         namespace fs = std::filesystem;
         fs::path outDir = fs::absolute(output).parent_path();

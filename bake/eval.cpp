@@ -50,7 +50,8 @@ nlohmann::json errorStats(std::vector<double> e) {
 }
 
 nlohmann::json evaluateDirections(const BakeData& bake, const Scene& scene, size_t pairs,
-                                  uint64_t seed, int order, float zMin, float zMax) {
+                                  uint64_t seed, int order, float zMin, float zMax,
+                                  const std::vector<int>* sampleOrder) {
     const SurfaceLayout& L = bake.layout;
     TraceOptions topt;
     const auto& m = bake.manifest;
@@ -81,7 +82,8 @@ nlohmann::json evaluateDirections(const BakeData& bake, const Scene& scene, size
         const Frame f = Frame::fromNormal(L.normal[p.sample]);
         PathResult truth = tracer.trace(L.position[p.sample], L.normal[p.sample], f.fromLocal(p.omegaLocal),
                                         L.part[p.sample]);
-        glm::vec4 d = decompressSample(bake, static_cast<int>(p.sample), p.omegaLocal, order);
+        const int o = sampleOrder ? (*sampleOrder)[p.sample] : order;
+        glm::vec4 d = decompressSample(bake, static_cast<int>(p.sample), p.omegaLocal, o);
         glm::vec3 e(d);
         float len = glm::length(e);
         double cosA = len > 0 ? glm::dot(e / len, truth.exit) : -1.0;
@@ -108,6 +110,35 @@ nlohmann::json evaluateDirections(const BakeData& bake, const Scene& scene, size
             {"capped", subset(kPathCapped, false)},
             {"reentered", subset(kPathReentered, false)},
             {"plain", subset(0, true)}};
+}
+
+std::vector<int> adaptiveOrders(const BakeData& bake, double toleranceDeg) {
+    const int n = bake.layout.sampleCount();
+    // 64 directions spread over the hemisphere (a Fibonacci spiral in z = cos(theta)).
+    std::vector<glm::vec3> dirs;
+    for (int k = 0; k < 64; ++k) {
+        float z = (k + 0.5f) / 64.0f, phi = 2.39996323f * k, s = std::sqrt(1 - z * z);
+        dirs.emplace_back(s * std::cos(phi), s * std::sin(phi), z);
+    }
+    std::vector<int> orders(n, bake.order);
+    tbb::parallel_for(0, n, [&](int i) {
+        std::vector<glm::vec3> full;
+        for (glm::vec3 w : dirs) full.push_back(glm::normalize(glm::vec3(decompressSample(bake, i, w))));
+        for (int l = 0; l < bake.order; ++l) {
+            double sum = 0;
+            for (size_t k = 0; k < dirs.size(); ++k) {
+                glm::vec3 e(decompressSample(bake, i, dirs[k], l));
+                float len = glm::length(e);
+                double c = len > 0 ? std::clamp(double(glm::dot(e / len, full[k])), -1.0, 1.0) : -1.0;
+                sum += std::acos(c) * 180.0 / M_PI;
+            }
+            if (sum / dirs.size() <= toleranceDeg) {
+                orders[i] = l;
+                break;
+            }
+        }
+    });
+    return orders;
 }
 
 namespace {

@@ -23,8 +23,15 @@ Scene sceneOfBake(const BakeData& bake, const std::string& bakePath, const std::
 // in degrees: mean, median, p95, p99, max; path-length error; the shares of TIR, capped and
 // re-entering paths, each with its own error. `order` < 0: all stored bands. cos(theta) of omega
 // is drawn uniformly in [zMin, zMax): [0, 0.1) probes grazing entry alone.
+// `sampleOrder`, if given, is the order used at each sample (per-sample adaptive order).
 nlohmann::json evaluateDirections(const BakeData& bake, const Scene& scene, size_t pairs,
-                                  uint64_t seed, int order = -1, float zMin = 0.0f, float zMax = 1.0f);
+                                  uint64_t seed, int order = -1, float zMin = 0.0f, float zMax = 1.0f,
+                                  const std::vector<int>* sampleOrder = nullptr);
+
+// Per-sample adaptive order: for each sample the smallest order whose reconstruction differs
+// from the full-order one by at most `toleranceDeg` on average over 64 fixed directions of the
+// hemisphere (the SH themselves are the yardstick, so no tracing is needed).
+std::vector<int> adaptiveOrders(const BakeData& bake, double toleranceDeg);
 
 // For each object-space surface point p and unit view direction w (toward the viewer): the
 // exit direction (normalized) and length the runtime would use there, interpolated across the

@@ -13,6 +13,7 @@
 #include "bake/eval.h"
 #include "bake/image_eval.h"
 #include "common/error.h"
+#include "common/sh.h"
 
 using namespace shrefract;
 
@@ -71,6 +72,14 @@ int main(int argc, char** argv) {
     dirs->add_option("--order", order, "evaluate with bands 0..order only (default: all stored)");
     dirs->add_option("--json", jsonPath, "write the report here");
     dirs->add_option("--scene", scenePath, "the baked mesh or scene, if not where the manifest says");
+    std::string tolText = "0.5,1,2,5,10";
+    auto* adaptive = app.add_subcommand(
+        "adaptive", "would a per-sample order pay? memory saved and error against fresh traces");
+    adaptive->add_option("bake", bakePath, "NAME.shrefract.exr")->required();
+    adaptive->add_option("--tolerances", tolText, "degrees, comma-separated")->capture_default_str();
+    adaptive->add_option("--pairs", pairs, "pairs for the error")->capture_default_str();
+    adaptive->add_option("--json", jsonPath, "write the report here");
+    adaptive->add_option("--scene", scenePath, "the baked mesh or scene, if not where the manifest says");
     auto* query = app.add_subcommand("query", "exit direction and length per (point, view direction)");
     query->add_option("bake", bakePath, "NAME.shrefract.exr")->required();
     query->add_option("--in", inPath, "CSV rows px,py,pz,wx,wy,wz (object space, w toward the viewer)")->required();
@@ -144,7 +153,33 @@ int main(int argc, char** argv) {
             return 0;
         }
         BakeData bake = readBake(bakePath);
-        if (dirs->parsed()) {
+        if (adaptive->parsed()) {
+            Scene scene = sceneOfBake(bake, bakePath, scenePath);
+            const size_t n = bake.layout.position.size();
+            nlohmann::json full = evaluateDirections(bake, scene, pairs, seed);
+            nlohmann::json report = {{"bake", bakePath}, {"order", bake.order},
+                                     {"full", {{"median", full["angleDeg"]["median"]}, {"p95", full["angleDeg"]["p95"]}}},
+                                     {"tolerances", nlohmann::json::array()}};
+            std::printf("per-sample adaptive order (bake order %d): full-order error median %.2f, p95 %.1f deg\n",
+                        bake.order, full["angleDeg"]["median"].get<double>(), full["angleDeg"]["p95"].get<double>());
+            std::printf("  %9s  %12s  %14s  %10s  %8s\n", "tolerance", "mean order", "weights kept", "median", "p95");
+            std::stringstream ss(tolText);
+            for (std::string t; std::getline(ss, t, ',');) {
+                const double tol = std::stod(t);
+                std::vector<int> orders = adaptiveOrders(bake, tol);
+                double kept = 0, meanOrder = 0;
+                for (int o : orders) kept += shEvenCount(o), meanOrder += o;
+                kept /= double(n) * shEvenCount(bake.order);
+                meanOrder /= double(n);
+                nlohmann::json r = evaluateDirections(bake, scene, pairs, seed, -1, 0.0f, 1.0f, &orders);
+                std::printf("  %8.2f°  %12.2f  %13.1f%%  %10.2f  %8.1f\n", tol, meanOrder, 100 * kept,
+                            r["angleDeg"]["median"].get<double>(), r["angleDeg"]["p95"].get<double>());
+                report["tolerances"].push_back({{"toleranceDeg", tol}, {"meanOrder", meanOrder},
+                                                {"weightsKept", kept}, {"median", r["angleDeg"]["median"]},
+                                                {"p95", r["angleDeg"]["p95"]}});
+            }
+            if (!jsonPath.empty()) writeAtomically(jsonPath, report.dump(2) + "\n");
+        } else if (dirs->parsed()) {
             Scene scene = sceneOfBake(bake, bakePath, scenePath);
             nlohmann::json report = evaluateDirections(bake, scene, pairs, seed, order);
             report["bake"] = bakePath;

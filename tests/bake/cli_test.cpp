@@ -137,3 +137,23 @@ TEST(BakeCli, BakesAndEvaluatesATetrahedron) {
 }
 
 }  // namespace
+
+namespace {
+
+// Ctrl-C (SIGINT) mid-bake: a clean stop, exit 130, no output file and no temporary left.
+TEST(BakeCli, InterruptStopsCleanlyAndWritesNothing) {
+    const std::string out = tmp("interrupted.shrefract.exr");
+    fs::remove(out);
+    // knot1 at rate 3 takes tens of seconds: long enough to interrupt after one.
+    const std::string cmd = "sh -c '" + kBake + " " + std::string(SHREFRACT_DATA_DIR) +
+                            "/meshes/knot1.off -o " + out +
+                            " --rate 3 --cache \"\" & pid=$!; sleep 1; kill -INT $pid; wait $pid; exit $?'";
+    CommandResult r = run(cmd);
+    EXPECT_EQ(r.code, 130) << r.out;
+    EXPECT_NE(r.out.find("cancelled"), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(out));
+    for (auto& e : fs::directory_iterator(SHREFRACT_TEST_TMP))
+        EXPECT_NE(e.path().string().rfind(out + ".tmp", 0), 0u) << "left behind: " << e.path();
+}
+
+}  // namespace

@@ -11,6 +11,7 @@
 
 #include "common/bakefile.h"
 #include "gl.h"
+#include "glsl.h"
 #include "glsl_baselines.h"
 
 namespace shrefract {
@@ -94,7 +95,7 @@ std::unique_ptr<Baseline> Baseline::create(const Bake& bake, const std::vector<f
                                     std::to_string(L.sampleCount()) + "), got " +
                                     std::to_string(normalDistance.size()));
     m->backProgram = buildProgram(glsl::kBaselineVertex, glsl::kBackFaceFragment, "Wyman back faces");
-    m->shadeProgram = buildProgram(glsl::kBaselineVertex, glsl::kBaselineFragment, "baseline shading");
+    m->shadeProgram = buildProgram(glsl::kBaselineVertex, glsl::withShadingLibrary(glsl::kBaselineFragment), "baseline shading");
     glUseProgram(m->shadeProgram);
     glUniform1i(glGetUniformLocation(m->shadeProgram, "uEnvironment"), 0);
     glUniform1i(glGetUniformLocation(m->shadeProgram, "uBack"), 1);

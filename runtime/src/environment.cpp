@@ -44,7 +44,7 @@ Environment Environment::fromLatLong(int width, int height, const std::vector<fl
     for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
         glTexParameteri(GL_TEXTURE_CUBE_MAP, wrap, GL_CLAMP_TO_EDGE);
     glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
-    env.program_ = buildProgram(glsl::kFullscreenVertex, glsl::kBackgroundFragment, "background");
+    env.program_ = buildProgram(glsl::kFullscreenVertex, glsl::withShadingLibrary(glsl::kBackgroundFragment), "background");
     glGenVertexArrays(1, &env.vao_);
     return env;
 }

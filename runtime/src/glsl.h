@@ -2,6 +2,8 @@
 // Each is a twin of CPU code in common/ and must stay in step with it.
 #pragma once
 
+#include <string>
+
 namespace shrefract::glsl {
 
 // Full-screen triangle; shared by every texture-space pass.
@@ -78,6 +80,45 @@ void main() {
 }
 )";
 
+// The shading every method shares, spliced after the #version line of the shaders that use it
+// (withShadingLibrary): so SH, the baselines and the background differ only in the exit
+// direction and length they pass in.
+inline const char* kShadingLibrary = R"(
+// common/optics.h FresnelDielectric: unpolarized, eta = n_t / n_i, 1 on TIR.
+float fresnelDielectric(float cosI, float eta) {
+    cosI = clamp(cosI, 0.0, 1.0);
+    float sin2T = (1.0 - cosI * cosI) / (eta * eta);
+    if (sin2T >= 1.0) return 1.0;
+    float cosT = sqrt(1.0 - sin2T);
+    float rParl = (eta * cosI - cosT) / (eta * cosI + cosT);
+    float rPerp = (cosI - eta * cosT) / (cosI + eta * cosT);
+    return 0.5 * (rParl * rParl + rPerp * rPerp);
+}
+
+// common/tonemap.h: exposure, the ACES fit of Narkowicz 2015, sRGB encoding.
+vec3 toneMap(vec3 c, float exposure) {
+    c *= exposure;
+    c = clamp((c * (2.51 * c + 0.03)) / (c * (2.43 * c + 0.59) + 0.14), 0.0, 1.0);
+    return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
+}
+
+// Front-surface Fresnel reflection plus the transmitted environment along the exit direction,
+// attenuated by exp(-kappa * length). n: unit normal, v: unit direction toward the viewer.
+vec3 shadeGlass(samplerCube env, vec3 exitDir, float len, vec3 n, vec3 v, float eta, vec3 kappa) {
+    float F = fresnelDielectric(dot(n, v), eta);
+    vec3 transmitted = texture(env, exitDir).rgb * exp(-kappa * max(len, 0.0));
+    vec3 reflected = texture(env, reflect(-v, n)).rgb;
+    return F * reflected + (1.0 - F) * transmitted;
+}
+)";
+
+// `source` with kShadingLibrary inserted after its first line (the #version directive).
+inline std::string withShadingLibrary(const char* source) {
+    std::string s(source);
+    const size_t eol = s.find('\n') + 1;
+    return s.substr(0, eol) + kShadingLibrary + s.substr(eol);
+}
+
 inline const char* kShadeVertex = R"(#version 330 core
 layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aNormal;
@@ -115,34 +156,14 @@ in vec2 vUV;
 layout(location = 0) out vec4 oColor;
 layout(location = 1) out vec4 oDirection;
 
-float fresnelDielectric(float cosI, float eta) {
-    cosI = clamp(cosI, 0.0, 1.0);
-    float sin2T = (1.0 - cosI * cosI) / (eta * eta);
-    if (sin2T >= 1.0) return 1.0;
-    float cosT = sqrt(1.0 - sin2T);
-    float rParl = (eta * cosI - cosT) / (eta * cosI + cosT);
-    float rPerp = (cosI - eta * cosT) / (cosI + eta * cosT);
-    return 0.5 * (rParl * rParl + rPerp * rPerp);
-}
-
-vec3 toneMap(vec3 c) {
-    c *= uExposure;
-    c = clamp((c * (2.51 * c + 0.03)) / (c * (2.43 * c + 0.59) + 0.14), 0.0, 1.0);
-    return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
-}
-
 void main() {
     vec4 r = texture(uRho, vUV);
     vec3 v = normalize(uEye - vPosition);
     // A (near) zero interpolated direction has no direction: go straight through, never NaN.
     float len2 = dot(r.xyz, r.xyz);
     vec3 exitWorld = len2 > 1e-20 ? normalize(uModelRotation * (r.xyz * inversesqrt(len2))) : -v;
-    vec3 n = normalize(vNormal);
-    float F = fresnelDielectric(dot(n, v), uEta);
-    vec3 transmitted = texture(uEnvironment, exitWorld).rgb * exp(-uKappa * max(r.w, 0.0));
-    vec3 reflected = texture(uEnvironment, reflect(-v, n)).rgb;
-    vec3 c = F * reflected + (1.0 - F) * transmitted;
-    oColor = vec4(uToneMap ? toneMap(c) : c, 1.0);
+    vec3 c = shadeGlass(uEnvironment, exitWorld, r.w, normalize(vNormal), v, uEta, uKappa);
+    oColor = vec4(uToneMap ? toneMap(c, uExposure) : c, 1.0);
     oDirection = vec4(exitWorld, 1.0);
 }
 )";
@@ -157,17 +178,11 @@ uniform float uExposure;
 layout(location = 0) out vec4 oColor;
 layout(location = 1) out vec4 oDirection;
 
-vec3 toneMap(vec3 c) {  // as in the shading shader (runtime.h toneMap)
-    c *= uExposure;
-    c = clamp((c * (2.51 * c + 0.03)) / (c * (2.43 * c + 0.59) + 0.14), 0.0, 1.0);
-    return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
-}
-
 void main() {
     vec2 ndc = (gl_FragCoord.xy - uViewportOrigin) / uViewport * 2.0 - 1.0;
     vec4 d = uInverseViewProjection * vec4(ndc, 1.0, 1.0);
     vec3 c = texture(uEnvironment, normalize(d.xyz / d.w)).rgb;
-    oColor = vec4(uToneMap ? toneMap(c) : c, 1.0);
+    oColor = vec4(uToneMap ? toneMap(c, uExposure) : c, 1.0);
     oDirection = vec4(0.0);
 }
 )";

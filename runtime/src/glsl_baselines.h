@@ -1,6 +1,6 @@
 // GLSL of the baselines (runtime/src/baselines.cpp, docs/evaluation.md): single-sided refraction
 // and Wyman 2005. Fresnel, absorption and the environment lookup are the SH shading's
-// (glsl.h kShadeFragment), so the methods differ only in the exit direction and length.
+// (glsl.h kShadingLibrary), so the methods differ only in the exit direction and length.
 #pragma once
 
 namespace shrefract::glsl {
@@ -58,16 +58,6 @@ in float vNormalDistance;
 layout(location = 0) out vec4 oColor;
 layout(location = 1) out vec4 oDirection;
 
-float fresnelDielectric(float cosI, float eta) {
-    cosI = clamp(cosI, 0.0, 1.0);
-    float sin2T = (1.0 - cosI * cosI) / (eta * eta);
-    if (sin2T >= 1.0) return 1.0;
-    float cosT = sqrt(1.0 - sin2T);
-    float rParl = (eta * cosI - cosT) / (eta * cosI + cosT);
-    float rPerp = (cosI - eta * cosT) / (cosI + eta * cosT);
-    return 0.5 * (rParl * rParl + rPerp * rPerp);
-}
-
 void main() {
     if (!gl_FrontFacing) discard;
     vec3 P1 = vPosition;
@@ -113,10 +103,7 @@ void main() {
         // P2 projected outside the back-face buffer: no second normal; T1 continues.
     }
     exitDir = normalize(exitDir);
-    float F = fresnelDielectric(dot(N1, V), uEta);
-    vec3 transmitted = texture(uEnvironment, exitDir).rgb * exp(-uKappa * max(len, 0.0));
-    vec3 reflected = texture(uEnvironment, reflect(-V, N1)).rgb;
-    oColor = vec4(F * reflected + (1.0 - F) * transmitted, 1.0);
+    oColor = vec4(shadeGlass(uEnvironment, exitDir, len, N1, V, uEta, uKappa), 1.0);
     oDirection = vec4(exitDir, 1.0);
 }
 )";

@@ -258,7 +258,7 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
     glUniform1i(glGetUniformLocation(m->unpackProgram, "uRhoIndex"), 0);
     glUniform1i(glGetUniformLocation(m->unpackProgram, "uD"), 1);
     glUniform1i(glGetUniformLocation(m->unpackProgram, "uMuWidth"), m->muW);
-    m->shadeProgram = buildProgram(glsl::kShadeVertex, glsl::kShadeFragment, "shading");
+    m->shadeProgram = buildProgram(glsl::kShadeVertex, glsl::withShadingLibrary(glsl::kShadeFragment), "shading");
     glUseProgram(m->shadeProgram);
     glUniform1i(glGetUniformLocation(m->shadeProgram, "uRho"), 0);
     glUniform1i(glGetUniformLocation(m->shadeProgram, "uEnvironment"), 1);

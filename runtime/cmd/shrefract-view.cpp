@@ -21,19 +21,31 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "gl.h"  // the runtime's loader: the viewer needs a handful of GL calls of its own
+#include "common/bakefile.h"
+#include "shrefract/baselines.h"
 #include "shrefract/render.h"
 #include "shrefract/runtime.h"
+#ifdef SHREFRACT_VIEW_WITH_BAKE
+#include "bake/eval.h"
+#include "bake/reference.h"
+#endif
 
 namespace {
 
 using namespace shrefract::gl;
 
-// Methods the viewer can switch between. Only the SH refraction map exists in the runtime now;
-// baselines join this list when they land.
-const char* kMethods[] = {"sh"};
+// Methods the viewer switches between with M. Wyman needs d_N by ray casting (the bake's
+// Embree), so it is there when the viewer is built with the bake library.
+#ifdef SHREFRACT_VIEW_WITH_BAKE
+const char* kMethods[] = {"sh", "single", "wyman"};
+#else
+const char* kMethods[] = {"sh", "single"};
+#endif
 
 struct Viewer {
     float azimuth = 30.0f, elevation = 20.0f, distance = 3.0f;
+    float radius = 1.0f;       // of the object's bounding sphere
+    glm::vec3 centre{0.0f};    // orbit target
     bool dragging = false;
     double lastX = 0, lastY = 0;
     int order = 0, maxOrder = 0, method = 0;
@@ -113,7 +125,8 @@ void onCursor(GLFWwindow* window, double x, double y) {
 
 void onScroll(GLFWwindow* window, double, double dy) {
     Viewer& v = state(window);
-    v.distance = std::clamp(v.distance * std::pow(0.9f, static_cast<float>(dy)), 0.2f, 100.0f);
+    v.distance = std::clamp(v.distance * std::pow(0.9f, static_cast<float>(dy)), 0.05f * v.radius,
+                            50.0f * v.radius);
 }
 
 void onGlfwError(int code, const char* text) {
@@ -138,6 +151,9 @@ int main(int argc, char** argv) {
     app.add_option("--screenshot", screenshotPath, "save the last frame here and exit (with --frames)");
     app.add_option("--frames", frames, "render N frames, then exit (0: run until Esc)");
     app.add_flag("--no-object", noObject, "draw the environment only (a reference for tests)");
+    std::string startMethod = "sh";
+    app.add_option("--method", startMethod, "method at start (M cycles): sh | single | wyman")
+        ->capture_default_str();
     CLI11_PARSE(app, argc, argv);
 
     int width = 0, height = 0;
@@ -184,8 +200,40 @@ int main(int argc, char** argv) {
         options.loader = reinterpret_cast<Loader>(&glfwGetProcAddress);
         auto refractor = shrefract::Refractor::create(bake, options);
 
+        // The other methods share the mesh; Wyman's d_N is cast once here.
+        std::vector<float> normalDistance;
+#ifdef SHREFRACT_VIEW_WITH_BAKE
+        {
+            const shrefract::SurfaceLayout& L = bake.data().layout;
+            shrefract::Scene scene = shrefract::sceneOfBake(bake.data(), bakePath);
+            shrefract::Tracer tracer(scene, shrefract::traceOptionsOfBake(bake.data()));
+            normalDistance = shrefract::normalDistances(tracer, L.position, L.normal);
+        }
+#endif
+        std::vector<std::unique_ptr<shrefract::Baseline>> baselines;
+        for (shrefract::BaselineMethod m : {shrefract::BaselineMethod::Single, shrefract::BaselineMethod::Wyman}) {
+            if (m == shrefract::BaselineMethod::Wyman && normalDistance.empty()) break;
+            shrefract::BaselineOptions bo;
+            bo.method = m;
+            bo.loader = options.loader;
+            bo.toneMap = true;
+            bo.exposure = exposure;
+            baselines.push_back(shrefract::Baseline::create(bake, normalDistance, bo));
+        }
+
         Viewer v;
+        {
+            glm::vec3 lo(1e30f), hi(-1e30f);
+            for (glm::vec3 p : bake.data().layout.position) lo = glm::min(lo, p), hi = glm::max(hi, p);
+            v.centre = 0.5f * (lo + hi);
+            v.radius = std::max(0.5f * glm::length(hi - lo), 1e-30f);
+            v.distance = 3.0f * v.radius;
+        }
         v.order = refractor->order();
+        v.method = -1;
+        for (int k = 0; k < static_cast<int>(std::size(kMethods)); ++k)
+            if (startMethod == kMethods[k]) v.method = k;
+        if (v.method < 0) throw std::invalid_argument("--method: not available here: " + startMethod);
         v.maxOrder = bake.order();
         v.smoothing = smoothing;
         glfwSetWindowUserPointer(window, &v);
@@ -210,18 +258,19 @@ int main(int argc, char** argv) {
 
             int fbw = 0, fbh = 0;
             glfwGetFramebufferSize(window, &fbw, &fbh);
-            shrefract::Camera cam = shrefract::Camera::orbit(v.azimuth, v.elevation, v.distance);
-            glm::mat4 view = glm::lookAt(cam.eye, cam.target, cam.up);
-            glm::mat4 projection = glm::perspective(glm::radians(cam.fovDegrees),
-                                                    float(fbw) / std::max(1, fbh), 0.01f, 1000.0f);
-            if (!noObject) refractor->update(cam.eye);
+            shrefract::Camera cam = shrefract::Camera::orbit(v.azimuth, v.elevation, v.distance, v.centre);
+            glm::mat4 view = shrefract::viewMatrix(cam);
+            glm::mat4 projection = shrefract::projectionMatrix(cam, fbw, std::max(1, fbh));
+            const bool sh = v.method == 0;
+            if (!noObject && sh) refractor->update(cam.eye);
             glBindFramebuffer(GL_FRAMEBUFFER, 0);
             glViewport(0, 0, fbw, fbh);
             glClearColor(0, 0, 0, 1);
             glDepthMask(GL_TRUE);
             glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
             env.drawBackground(view, projection, true, exposure);
-            if (!noObject) refractor->draw(view, projection, glm::mat4(1.0f), env);
+            if (!noObject && sh) refractor->draw(view, projection, glm::mat4(1.0f), env);
+            if (!noObject && !sh) baselines[v.method - 1]->draw(view, projection, glm::mat4(1.0f), env);
             ensureLoaded(reinterpret_cast<Loader>(&glfwGetProcAddress));
 
             ++frame;

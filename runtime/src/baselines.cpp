@@ -206,6 +206,8 @@ void Baseline::draw(const glm::mat4& view, const glm::mat4& projection, const gl
     glUniform1i(glGetUniformLocation(p, "uMethod"), wyman ? 1 : 0);
     glUniform1i(glGetUniformLocation(p, "uTir"), static_cast<int>(m.options.tir));
     glUniform2f(glGetUniformLocation(p, "uViewportOrigin"), float(viewport[0]), float(viewport[1]));
+    glUniform1i(glGetUniformLocation(p, "uToneMap"), m.options.toneMap ? 1 : 0);
+    glUniform1f(glGetUniformLocation(p, "uExposure"), m.options.exposure);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_CUBE_MAP, environment.cubeMap());
     glActiveTexture(GL_TEXTURE1);

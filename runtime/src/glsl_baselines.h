@@ -52,6 +52,8 @@ uniform float uScale;          // world units per object unit (for d_N and the l
 uniform int uMethod;           // 0 single, 1 Wyman
 uniform int uTir;              // 0 reflect, 1 straight, 2 grazing
 uniform vec2 uViewportOrigin;
+uniform bool uToneMap;
+uniform float uExposure;
 in vec3 vPosition;
 in vec3 vNormal;
 in float vNormalDistance;
@@ -103,7 +105,8 @@ void main() {
         // P2 projected outside the back-face buffer: no second normal; T1 continues.
     }
     exitDir = normalize(exitDir);
-    oColor = vec4(shadeGlass(uEnvironment, exitDir, len, N1, V, uEta, uKappa), 1.0);
+    vec3 c = shadeGlass(uEnvironment, exitDir, len, N1, V, uEta, uKappa);
+    oColor = vec4(uToneMap ? toneMap(c, uExposure) : c, 1.0);
     oDirection = vec4(exitDir, 1.0);
 }
 )";

@@ -15,3 +15,8 @@ run() { xvfb-run -a -s "-screen 0 800x600x24" "$viewer" "$bake" --env "$env" --s
 run --screenshot "$work/shot.png" --frames 3
 run --screenshot "$work/background.png" --frames 3 --no-object
 "$png_diff" "$work/shot.png" "$work/background.png" 0.05
+# The method switch: Wyman's two-sided refraction draws the glass too, and differently from SH.
+rm -f "$work/wyman.png"
+run --screenshot "$work/wyman.png" --frames 3 --method wyman
+"$png_diff" "$work/wyman.png" "$work/background.png" 0.05
+"$png_diff" "$work/wyman.png" "$work/shot.png" 0.01

@@ -28,6 +28,8 @@ struct BaselineOptions {
     BaselineMethod method = BaselineMethod::Wyman;
     WymanTir tir = WymanTir::Reflect;
     bool timings = true;                     // GL timer queries around each pass
+    bool toneMap = false;                    // draw display values (toneMap()) instead of HDR
+    float exposure = 1.0f;
     void* (*loader)(const char*) = nullptr;  // GL function loader; nullptr: guess from context
 };
 

@@ -236,6 +236,14 @@ int main(int argc, char** argv) {
                             }
                         }
                 }
+                // Spatial smoothing through the neighbour lists (paper §4.3), order 8.
+                {
+                    RefractorOptions o;
+                    o.maxOrder = 8, o.order = 8, o.smoothing = true;
+                    point("smoothing", "on", 1, renderSh(full, o));
+                    o.smoothing = false;
+                    point("smoothing", "off", 0, renderSh(full, o));
+                }
                 // Filter widths: scale band l by h_l, as --filter folds into M.
                 BakeData order8 = res.data;
                 {

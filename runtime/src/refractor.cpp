@@ -177,7 +177,12 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
     const int K = shEvenCount(m->maxOrder);
     const size_t layer = static_cast<size_t>(m->muW) * m->muH * 4;
     const size_t muTexels = static_cast<size_t>(m->muW) * m->muH;
-    m->memory.weights = K * muTexels * 16;  // RGBA32F
+    // Weights stored at half or 8 bits in the file go to the GPU as RGBA16F: half the memory of
+    // RGBA32F, and no precision the file had is lost (u8 codes dequantize to within half's 11
+    // bits). Float32 bakes stay RGBA32F.
+    const bool half = d.precision != Precision::F32;
+    const GLenum weightFormat = half ? GL_RGBA16F : GL_RGBA32F;
+    m->memory.weights = K * muTexels * (half ? 8 : 16);
     m->memory.samples = 2 * muTexels * 12;  // P, N: RGB32F
     m->memory.rho = static_cast<size_t>(m->rhoW) * m->rhoH * 16;  // RGBA32UI
     std::vector<float> padded(layer, 0.0f);
@@ -191,7 +196,7 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
                                      std::to_string(maxLayers) + " (set maxOrder lower)");
         glGenTextures(1, &m->weightArray);
         glBindTexture(GL_TEXTURE_2D_ARRAY, m->weightArray);
-        glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA32F, m->muW, m->muH, K, 0, GL_RGBA, GL_FLOAT,
+        glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, weightFormat, m->muW, m->muH, K, 0, GL_RGBA, GL_FLOAT,
                      nullptr);
         glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
         glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
@@ -203,7 +208,7 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
             glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, k, m->muW, m->muH, 1, GL_RGBA, GL_FLOAT,
                             padded.data());
         } else {
-            m->weightTex.push_back(makeTexture2D(GL_RGBA32F, m->muW, m->muH, GL_RGBA, GL_FLOAT,
+            m->weightTex.push_back(makeTexture2D(weightFormat, m->muW, m->muH, GL_RGBA, GL_FLOAT,
                                                  padded.data(), GL_NEAREST));
         }
     }

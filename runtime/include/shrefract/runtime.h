@@ -76,7 +76,8 @@ struct Timings {
 // GPU memory a Refractor allocated, bytes of texel storage at the internal formats it asked
 // for (drivers may pad): what paper Figure 12 counts.
 struct GpuMemory {
-    size_t weights = 0;     // SH weights of the uploaded bands, RGBA32F, mu size each
+    size_t weights = 0;     // SH weights of the uploaded bands, mu size each: RGBA32F for f32
+                            // bakes, RGBA16F for f16 and u8 bakes
     size_t samples = 0;     // positions and normals, RGB32F, mu size
     size_t rho = 0;         // rho index texture (which sample or correction per texel)
     size_t neighbours = 0;  // smoothing lists (CSR)

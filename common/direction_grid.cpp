@@ -29,30 +29,6 @@ void checkGrid(const DirectionGrid& g) {
     SHREFRACT_CHECK(g.nTheta >= 1 && g.nPhi >= 2 && g.nPhi % 2 == 0);
 }
 
-// Gauss-Legendre nodes and weights on [-1, 1]: Newton on P_q from Chebyshev guesses.
-void gaussLegendre(int q, std::vector<double>* x, std::vector<double>* w) {
-    x->assign(q, 0.0);
-    w->assign(q, 0.0);
-    for (int i = 0; i < q; ++i) {
-        double t = std::cos(kPi * (i + 0.75) / (q + 0.5));
-        double dp = 1.0;
-        for (int it = 0; it < 100; ++it) {
-            double p0 = 1.0, p1 = t;  // P_0, P_1; Bonnet: n P_n = (2n-1) t P_{n-1} - (n-1) P_{n-2}
-            for (int n = 2; n <= q; ++n) {
-                double p2 = ((2.0 * n - 1.0) * t * p1 - (n - 1.0) * p0) / n;
-                p0 = p1;
-                p1 = p2;
-            }
-            dp = q * (t * p1 - p0) / (t * t - 1.0);  // P_q'(t)
-            double dt = p1 / dp;
-            t -= dt;
-            if (std::fabs(dt) < 1e-16) break;
-        }
-        (*x)[i] = t;
-        (*w)[i] = 2.0 / ((1.0 - t * t) * dp * dp);
-    }
-}
-
 // Normalized associated Legendre Pbar_l^m(cos theta) = K_l^m P_l^m (no Condon-Shortley phase),
 // all 0 <= m <= l <= L, stored at l*(l+1)/2 + m.
 void legendreAll(int L, double theta, double* out) {
@@ -157,6 +133,31 @@ bool writeCache(const std::string& path, const DirectionGrid& g, int L, int q,
 }
 
 }  // namespace
+
+// Newton on P_q from Chebyshev guesses.
+void gaussLegendre(int q, std::vector<double>* x, std::vector<double>* w) {
+    x->assign(q, 0.0);
+    w->assign(q, 0.0);
+    for (int i = 0; i < q; ++i) {
+        double t = std::cos(kPi * (i + 0.75) / (q + 0.5));
+        double dp = 1.0;
+        for (int it = 0; it < 100; ++it) {
+            double p0 = 1.0, p1 = t;  // P_0, P_1; Bonnet: n P_n = (2n-1) t P_{n-1} - (n-1) P_{n-2}
+            for (int n = 2; n <= q; ++n) {
+                double p2 = ((2.0 * n - 1.0) * t * p1 - (n - 1.0) * p0) / n;
+                p0 = p1;
+                p1 = p2;
+            }
+            dp = q * (t * p1 - p0) / (t * t - 1.0);  // P_q'(t)
+            double dt = p1 / dp;
+            t -= dt;
+            if (std::fabs(dt) < 1e-16) break;
+        }
+        (*x)[i] = t;
+        (*w)[i] = 2.0 / ((1.0 - t * t) * dp * dp);
+    }
+}
+
 
 double DirectionGrid::theta(int i) const { return (i + 0.5) * (0.5 * kPi) / nTheta; }
 double DirectionGrid::phi(int k) const { return (k + 0.5) * (2.0 * kPi) / nPhi; }

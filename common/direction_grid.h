@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 #include <glm/glm.hpp>
@@ -29,6 +30,10 @@ struct DirectionGrid {
 };
 // Parses "32x64"; throws InputError naming `what` on bad text.
 DirectionGrid parseGrid(const std::string& text, const std::string& what = "--grid");
+
+// Gauss-Legendre nodes and weights on [-1, 1] (Newton on P_q): exact for polynomials of degree
+// up to 2q - 1. The quadrature behind M, and the tests' integrals over the sphere.
+void gaussLegendre(int q, std::vector<double>* x, std::vector<double>* w);
 
 // M (K x J), K = shEvenCount(L) rows in even order, J = grid.count() columns, double precision,
 // by Gauss-Legendre quadrature with `q` x `q` points in every interpolation cell.

@@ -1,5 +1,6 @@
 // Tests for common/sh.h: the exact polynomials against the Legendre recurrence, orthonormality,
 // the sign convention, even-parity storage and the band filter.
+#include "common/direction_grid.h"
 #include "common/sh.h"
 
 #include <gtest/gtest.h>
@@ -23,28 +24,6 @@ glm::dvec3 randomDirection(std::mt19937_64& rng) {
     return glm::normalize(v);
 }
 
-// Gauss-Legendre nodes/weights on [-1, 1] (Newton on P_n), for quadrature in z = cos theta.
-void gaussLegendre(int n, std::vector<double>* x, std::vector<double>* w) {
-    x->resize(n);
-    w->resize(n);
-    for (int i = 0; i < n; ++i) {
-        double t = std::cos(kPi * (i + 0.75) / (n + 0.5)), dp = 1.0;
-        for (int it = 0; it < 100; ++it) {
-            double p0 = 1.0, p1 = t;
-            for (int k = 2; k <= n; ++k) {
-                double p2 = ((2.0 * k - 1.0) * t * p1 - (k - 1.0) * p0) / k;
-                p0 = p1;
-                p1 = p2;
-            }
-            dp = n * (t * p1 - p0) / (t * t - 1.0);
-            double dt = p1 / dp;
-            t -= dt;
-            if (std::fabs(dt) < 1e-16) break;
-        }
-        (*x)[i] = t;
-        (*w)[i] = 2.0 / ((1.0 - t * t) * dp * dp);
-    }
-}
 
 // Sphere quadrature: Gauss-Legendre in z (nz nodes, exact to degree 2 nz - 1) times the
 // trapezoid rule in phi (nPhi points, exact for trigonometric degree < nPhi). Calls f(w, weight).

@@ -49,59 +49,16 @@ glm::mat4 projectionMatrix(const Camera& camera, int width, int height) {
 
 namespace {
 
-// Offscreen colour + direction targets, the background, then `drawObject(view, projection)`.
+// Offscreen colour + direction targets (OffscreenTarget), then `drawObject(view, projection)`,
+// read back.
 RenderedFrame renderWith(const std::function<void(const glm::mat4&, const glm::mat4&)>& drawObject,
                          const Camera& camera, int width, int height) {
     ensureLoaded(currentContextLoader());
-    RenderedFrame out;
-    out.width = width;
-    out.height = height;
-    // Colour (RGBA32F), direction buffer (RGBA32F) and depth.
-    GLuint textures[2], depth = 0, fbo = 0;
-    glGenTextures(2, textures);
-    for (GLuint t : textures) {
-        glBindTexture(GL_TEXTURE_2D, t);
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    }
-    glGenRenderbuffers(1, &depth);
-    glBindRenderbuffer(GL_RENDERBUFFER, depth);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
-    glGenFramebuffers(1, &fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, textures[0], 0);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, textures[1], 0);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
-    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-    glDrawBuffers(2, buffers);
-    bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
-    if (complete) {
-        glViewport(0, 0, width, height);
-        glClearColor(0, 0, 0, 0);
-        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-        glm::mat4 view = viewMatrix(camera);
-        glm::mat4 projection = projectionMatrix(camera, width, height);
-        drawObject(view, projection);
-        glFinish();
-        // Read back, flipping GL's bottom-up rows to top-down.
-        std::vector<float> rows(static_cast<size_t>(width) * height * 4);
-        for (int a = 0; a < 2; ++a) {
-            glReadBuffer(buffers[a]);
-            glPixelStorei(GL_PACK_ALIGNMENT, 1);
-            glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, rows.data());
-            std::vector<float>& dst = a == 0 ? out.color : out.directions;
-            dst.resize(rows.size());
-            const size_t stride = static_cast<size_t>(width) * 4;
-            for (int y = 0; y < height; ++y)
-                std::copy_n(&rows[(height - 1 - y) * stride], stride, &dst[y * stride]);
-        }
-    }
+    OffscreenTarget target(width, height);
+    target.bind();
+    drawObject(viewMatrix(camera), projectionMatrix(camera, width, height));
+    RenderedFrame out = target.read();
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    glDeleteFramebuffers(1, &fbo);
-    glDeleteRenderbuffers(1, &depth);
-    glDeleteTextures(2, textures);
-    if (!complete) throw std::runtime_error("shrefract: offscreen framebuffer incomplete");
     return out;
 }
 

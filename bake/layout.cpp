@@ -62,10 +62,13 @@ SurfaceLayout buildJoiningLayout(const Scene& scene, int rate) {
     const int r = rate;
     SurfaceLayout L;
     L.rate = r;
-    // Two triangles per block; w + h >= 2r + 5 keeps each triangle's correction texels
-    // (i + j = r + 1) off its partner's samples and corrections (see docs/format.md).
-    L.blockWidth = r + 2;
-    L.blockHeight = r + 3;
+    // Two triangles per block, the second rotated 180 degrees. In block coordinates the first
+    // one's samples lie on diagonals x + y <= r and its corrections on r + 1; the partner's
+    // corrections on w + h - r - 3 and its samples from w + h - r - 2 up. w + h = 2r + 5 makes
+    // those r + 2 and r + 3: no texel is shared. Width r + 1 is the least that holds a row of
+    // r + 1 samples, so the block is (r + 1) x (r + 4).
+    L.blockWidth = r + 1;
+    L.blockHeight = r + 4;
 
     size_t triangles = 0;
     for (const Part& p : scene.parts) triangles += p.mesh.triangles.size();
@@ -143,7 +146,9 @@ SurfaceLayout buildJoiningLayout(const Scene& scene, int rate) {
                     uint32_t s = id(i, j);
                     ids[j * (r + 1) + i] = s;
                     glm::ivec2 x = L.rhoTexel(t, i, j);
-                    L.rho[size_t(x.y) * L.rhoWidth + x.x] = RhoTexel{RhoTexel::Sample, s, 0, 0};
+                    RhoTexel& tx = L.rho[size_t(x.y) * L.rhoWidth + x.x];
+                    SHREFRACT_CHECK_EQ(tx.kind, uint32_t(RhoTexel::Empty));
+                    tx = RhoTexel{RhoTexel::Sample, s, 0, 0};
                 }
             }
             // Correction texels just outside the hypotenuse: v11 = v10 + v01 - v00.

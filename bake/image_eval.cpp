@@ -1,6 +1,5 @@
 #include "bake/image_eval.h"
 
-#include <png.h>
 
 #include <algorithm>
 #include <cctype>
@@ -10,6 +9,7 @@
 
 #include "bake/eval.h"
 #include "common/error.h"
+#include "common/png.h"
 #include "common/tonemap.h"
 
 namespace shrefract {
@@ -266,30 +266,7 @@ Image8 montage(const std::vector<std::vector<Image8>>& rows,
 }
 
 void writePng8(const std::string& path, const Image8& image) {
-    const std::string tmp = path + ".tmp";
-    FILE* f = std::fopen(tmp.c_str(), "wb");
-    if (!f) throw inputError(path, "cannot write");
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-    png_infop info = png ? png_create_info_struct(png) : nullptr;
-    if (!png || !info || setjmp(png_jmpbuf(png))) {
-        png_destroy_write_struct(&png, &info);
-        std::fclose(f);
-        std::remove(tmp.c_str());
-        throw inputError(path, "libpng failed");
-    }
-    png_init_io(png, f);
-    png_set_IHDR(png, info, image.width, image.height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-    png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
-    png_write_info(png, info);
-    for (int y = 0; y < image.height; ++y)
-        png_write_row(png, const_cast<uint8_t*>(&image.rgb[static_cast<size_t>(y) * image.width * 3]));
-    png_write_end(png, nullptr);
-    png_destroy_write_struct(&png, &info);
-    if (std::fclose(f) != 0 || std::rename(tmp.c_str(), path.c_str()) != 0) {
-        std::remove(tmp.c_str());
-        throw inputError(path, "cannot write");
-    }
+    writePngRgb8(path, image.width, image.height, image.rgb.data());
 }
 
 }  // namespace shrefract

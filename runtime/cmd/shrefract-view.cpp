@@ -7,7 +7,6 @@
 // which are also printed once a second. No GUI toolkit: the HUD is the title bar and stdout.
 #define GLFW_INCLUDE_NONE  // GL comes from the runtime's loader (gl.h), not GL/gl.h
 #include <GLFW/glfw3.h>
-#include <png.h>
 
 #include <algorithm>
 #include <chrono>
@@ -22,6 +21,7 @@
 
 #include "gl.h"  // the runtime's loader: the viewer needs a handful of GL calls of its own
 #include "common/bakefile.h"
+#include "common/png.h"
 #include "shrefract/baselines.h"
 #include "shrefract/render.h"
 #include "shrefract/runtime.h"
@@ -52,27 +52,6 @@ struct Viewer {
     bool smoothing = false, timings = true, screenshot = false, quit = false;
 };
 
-// 8-bit RGB PNG, rows top-down; throws naming the file.
-void writePng8(const std::string& path, int w, int h, const std::vector<unsigned char>& rgb) {
-    FILE* f = std::fopen(path.c_str(), "wb");
-    if (!f) throw std::runtime_error(path + ": cannot open for writing");
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-    png_infop info = png ? png_create_info_struct(png) : nullptr;
-    if (!png || !info || setjmp(png_jmpbuf(png))) {
-        png_destroy_write_struct(&png, &info);
-        std::fclose(f);
-        throw std::runtime_error(path + ": libpng failed");
-    }
-    png_init_io(png, f);
-    png_set_IHDR(png, info, w, h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-    png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
-    png_write_info(png, info);
-    for (int y = 0; y < h; ++y) png_write_row(png, &rgb[static_cast<size_t>(y) * w * 3]);
-    png_write_end(png, nullptr);
-    png_destroy_write_struct(&png, &info);
-    if (std::fclose(f) != 0) throw std::runtime_error(path + ": write failed");
-}
 
 // Reads the back buffer (display values: everything is drawn tone mapped) into a PNG.
 void saveScreenshot(const std::string& path, int w, int h) {
@@ -84,7 +63,7 @@ void saveScreenshot(const std::string& path, int w, int h) {
     const size_t stride = static_cast<size_t>(w) * 3;
     for (int y = 0; y < h; ++y)
         std::copy_n(&rows[(h - 1 - y) * stride], stride, &flipped[y * stride]);
-    writePng8(path, w, h, flipped);
+    shrefract::writePngRgb8(path, w, h, flipped.data());
     std::printf("saved %s (%dx%d)\n", path.c_str(), w, h);
 }
 

@@ -1,6 +1,5 @@
 #include "shrefract/render.h"
 
-#include <png.h>
 
 #include <algorithm>
 #include <cmath>
@@ -14,6 +13,7 @@
 #include <ImfHeader.h>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "common/png.h"
 #include "common/tonemap.h"
 #include "shrefract/baselines.h"
 #include "gl.h"
@@ -196,26 +196,7 @@ void writePng(const std::string& path, const RenderedFrame& frame, float exposur
         for (int k = 0; k < 3; ++k)
             pixels[3 * i + k] = static_cast<unsigned char>(std::lround(c[k] * 255.0f));
     }
-    writeAtomically(path, [&](const std::string& tmp) {
-        FILE* f = std::fopen(tmp.c_str(), "wb");
-        if (!f) throw std::runtime_error("cannot open");
-        png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-        png_infop info = png ? png_create_info_struct(png) : nullptr;
-        if (!png || !info || setjmp(png_jmpbuf(png))) {
-            png_destroy_write_struct(&png, &info);
-            std::fclose(f);
-            throw std::runtime_error("libpng failed");
-        }
-        png_init_io(png, f);
-        png_set_IHDR(png, info, w, h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-                     PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-        png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
-        png_write_info(png, info);
-        for (int y = 0; y < h; ++y) png_write_row(png, &pixels[static_cast<size_t>(y) * w * 3]);
-        png_write_end(png, nullptr);
-        png_destroy_write_struct(&png, &info);
-        if (std::fclose(f) != 0) throw std::runtime_error("close failed");
-    });
+    writePngRgb8(path, w, h, pixels.data());
 }
 
 void writeExr(const std::string& path, int width, int height, const std::vector<float>& rgba) {

@@ -1,4 +1,4 @@
-// HDR to display, shared by the runtime (C++ and its GLSL twin in runtime/src/glsl.h) and the
+// HDR to display, shared by the runtime (C++ and its GLSL twin in shaders/shading.glsl) and the
 // bake-side reference renderer and image metrics, so every image is tone mapped alike.
 #pragma once
 

@@ -11,8 +11,7 @@
 
 #include "common/bakefile.h"
 #include "gl.h"
-#include "glsl.h"
-#include "glsl_baselines.h"
+#include "shaders.h"
 
 namespace shrefract {
 
@@ -94,8 +93,8 @@ std::unique_ptr<Baseline> Baseline::create(const Bake& bake, const std::vector<f
         throw std::invalid_argument("shrefract: Wyman needs d_N for every bake sample (" +
                                     std::to_string(L.sampleCount()) + "), got " +
                                     std::to_string(normalDistance.size()));
-    m->backProgram = buildProgram(glsl::kBaselineVertex, glsl::kBackFaceFragment, "Wyman back faces");
-    m->shadeProgram = buildProgram(glsl::kBaselineVertex, glsl::withShadingLibrary(glsl::kBaselineFragment), "baseline shading");
+    m->backProgram = buildProgram(shaders::source("baseline.vert"), shaders::source("back_face.frag"), "Wyman back faces");
+    m->shadeProgram = buildProgram(shaders::source("baseline.vert"), shaders::source("baseline.frag"), "baseline shading");
     glUseProgram(m->shadeProgram);
     glUniform1i(glGetUniformLocation(m->shadeProgram, "uEnvironment"), 0);
     glUniform1i(glGetUniformLocation(m->shadeProgram, "uBack"), 1);

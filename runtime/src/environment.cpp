@@ -8,7 +8,7 @@
 #include "common/error.h"
 #include "common/latlong.h"
 #include "gl.h"
-#include "glsl.h"
+#include "shaders.h"
 #include "shrefract/runtime.h"
 
 namespace shrefract {
@@ -44,7 +44,7 @@ Environment Environment::fromLatLong(int width, int height, const std::vector<fl
     for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
         glTexParameteri(GL_TEXTURE_CUBE_MAP, wrap, GL_CLAMP_TO_EDGE);
     glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
-    env.program_ = buildProgram(glsl::kFullscreenVertex, glsl::withShadingLibrary(glsl::kBackgroundFragment), "background");
+    env.program_ = buildProgram(shaders::source("fullscreen.vert"), shaders::source("background.frag"), "background");
     glGenVertexArrays(1, &env.vao_);
     return env;
 }

@@ -12,7 +12,7 @@
 #include "common/bakefile.h"
 #include "common/sh.h"
 #include "gl.h"
-#include "glsl.h"
+#include "shaders.h"
 #include "shadergen.h"
 #include "shrefract/runtime.h"
 
@@ -247,23 +247,23 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 
     // Fixed programs.
-    m->viewProgram = buildProgram(glsl::kFullscreenVertex, glsl::kLocalViewFragment, "local view");
+    m->viewProgram = buildProgram(shaders::source("fullscreen.vert"), shaders::source("local_view.frag"), "local view");
     glUseProgram(m->viewProgram);
     glUniform1i(glGetUniformLocation(m->viewProgram, "uPosition"), 0);
     glUniform1i(glGetUniformLocation(m->viewProgram, "uNormal"), 1);
-    m->smoothProgram = buildProgram(glsl::kFullscreenVertex, glsl::kSmoothFragment, "smoothing");
+    m->smoothProgram = buildProgram(shaders::source("fullscreen.vert"), shaders::source("smooth.frag"), "smoothing");
     glUseProgram(m->smoothProgram);
     const char* smoothSamplers[] = {"uD", "uRange", "uNbrIndex", "uNbrWeight"};
     for (int u = 0; u < 4; ++u)
         glUniform1i(glGetUniformLocation(m->smoothProgram, smoothSamplers[u]), u);
     glUniform1i(glGetUniformLocation(m->smoothProgram, "uMuWidth"), m->muW);
     glUniform1i(glGetUniformLocation(m->smoothProgram, "uListWidth"), m->listWidth);
-    m->unpackProgram = buildProgram(glsl::kFullscreenVertex, glsl::kUnpackFragment, "unpack");
+    m->unpackProgram = buildProgram(shaders::source("fullscreen.vert"), shaders::source("unpack.frag"), "unpack");
     glUseProgram(m->unpackProgram);
     glUniform1i(glGetUniformLocation(m->unpackProgram, "uRhoIndex"), 0);
     glUniform1i(glGetUniformLocation(m->unpackProgram, "uD"), 1);
     glUniform1i(glGetUniformLocation(m->unpackProgram, "uMuWidth"), m->muW);
-    m->shadeProgram = buildProgram(glsl::kShadeVertex, glsl::withShadingLibrary(glsl::kShadeFragment), "shading");
+    m->shadeProgram = buildProgram(shaders::source("shade.vert"), shaders::source("shade.frag"), "shading");
     glUseProgram(m->shadeProgram);
     glUniform1i(glGetUniformLocation(m->shadeProgram, "uRho"), 0);
     glUniform1i(glGetUniformLocation(m->shadeProgram, "uEnvironment"), 1);

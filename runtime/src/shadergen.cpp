@@ -1,5 +1,7 @@
 #include "shadergen.h"
 
+#include "shaders.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -170,13 +172,16 @@ std::string polyExpression(const ShPolynomial& p) {
     return e.empty() ? "0.0" : e;
 }
 
-std::string fragmentSource(const DecompressionShaders& s, int index, const PassPlan& plan,
-                           const std::vector<ShPolynomial>& polys, DecompressionPass& pass) {
+// The generated part of a pass: its header comment, the weight samplers and
+//   vec4 shPass(ivec2 p, vec3 w, vec4 s)
+// which returns s plus weight(p) x y_k(w) for every function k of the pass. It replaces the
+// "#pragma shrefract_generated" line of shaders/decompress.frag.
+std::string generatedPass(const DecompressionShaders& s, int index, const PassPlan& plan,
+                          const std::vector<ShPolynomial>& polys, DecompressionPass& pass) {
     const bool first = index == 0;
     const ShaderLimits& l = s.limits;
     std::ostringstream o;
-    o << "#version " << l.version << "\n"
-      << "// shrefract SH decompression, pass " << index + 1 << " of " << s.passes.size()
+    o << "// shrefract SH decompression, pass " << index + 1 << " of " << s.passes.size()
       << ": order " << s.order << ", limits \"" << l.name << "\" (" << l.maxTextureUnits
       << " texture units, "
       << (l.maxAluInstructions > 0 ? std::to_string(l.maxAluInstructions) : "unlimited")
@@ -186,13 +191,8 @@ std::string fragmentSource(const DecompressionShaders& s, int index, const PassP
     if (s.form == ShForm::Recurrence)
         o << "// Form: associated Legendre recurrence, Q_l^m = Pbar_l^m / sin^m theta, times\n"
           << "// Re/Im (x + iy)^m (no trigonometry, no division; common/sh.cpp shEvalEven).\n";
-    o
-      << "uniform sampler2D uLocalView;  // local view direction per mu sample (xyz)\n";
     pass.samplers.push_back({SamplerBinding::LocalView, -1, "uLocalView"});
-    if (!first) {
-        o << "uniform sampler2D uPartialSum;  // the sum of the passes before this one\n";
-        pass.samplers.push_back({SamplerBinding::PartialSum, -1, "uPartialSum"});
-    }
+    if (!first) pass.samplers.push_back({SamplerBinding::PartialSum, -1, "uPartialSum"});
     if (l.weightArray) {
         o << "uniform sampler2DArray uWeights;  // layer k: weights of y_k (exit x, y, z, length)\n";
         pass.samplers.push_back({SamplerBinding::WeightArray, -1, "uWeights"});
@@ -204,12 +204,9 @@ std::string fragmentSource(const DecompressionShaders& s, int index, const PassP
             pass.samplers.push_back({SamplerBinding::Weight, k, name});
         }
     }
-    o << "layout(location = 0) out vec4 oSum;\n\n"
-      << "void main() {\n"
-      << "    ivec2 p = ivec2(gl_FragCoord.xy);\n"
-      << "    vec3 w = texelFetch(uLocalView, p, 0).xyz;\n"
-      << "    float x = w.x, y = w.y, z = w.z;\n"
-      << (first ? "    vec4 s = vec4(0.0);\n" : "    vec4 s = texelFetch(uPartialSum, p, 0);\n");
+    o << "\n"
+      << "vec4 shPass(ivec2 p, vec3 w, vec4 s) {\n"
+      << "    float x = w.x, y = w.y, z = w.z;\n";
     auto fetch = [&](int k) {
         return l.weightArray ? "texelFetch(uWeights, ivec3(p, " + std::to_string(k) + "), 0)"
                              : "texelFetch(uWeight" + std::to_string(k) + ", p, 0)";
@@ -249,7 +246,7 @@ std::string fragmentSource(const DecompressionShaders& s, int index, const PassP
                 }
             }
         }
-        o << "    oSum = s;\n}\n";
+        o << "    return s;\n}";
         return o.str();
     }
     if (!plan.monos.order.empty()) o << "    // monomials, each computed once for this pass\n";
@@ -266,8 +263,17 @@ std::string fragmentSource(const DecompressionShaders& s, int index, const PassP
           << "    //   " << exact.substr(exact.find('=')) << "\n"
           << "    s += " << fetch(k) << " * (" << polyExpression(p) << ");\n";
     }
-    o << "    oSum = s;\n}\n";
+    o << "    return s;\n}";
     return o.str();
+}
+
+// The whole fragment shader of pass `index`: shaders/decompress.frag with the generated part.
+std::string fragmentSource(const DecompressionShaders& s, int index, const PassPlan& plan,
+                           const std::vector<ShPolynomial>& polys, DecompressionPass& pass) {
+    const std::string generated = generatedPass(s, index, plan, polys, pass);
+    return shaders::withVersion(
+        shaders::fill(shaders::source("decompress.frag"), "#pragma shrefract_generated", generated),
+        s.limits.version, index == 0 ? "#define SHREFRACT_FIRST_PASS" : "");
 }
 
 int functionAlu(const ShPolynomial& p) { return static_cast<int>(p.terms.size()) + 1; }
@@ -342,12 +348,7 @@ DecompressionShaders generateForm(int order, const ShaderLimits& limits, ShForm 
     }
     // Readable output: functions ascending within a pass, monomials by first use kept.
     out.passes.resize(plans.size());
-    out.vertex = "#version " + limits.version +
-                 "\n// Full-screen triangle from gl_VertexID (no attributes).\n"
-                 "void main() {\n"
-                 "    vec2 c = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);\n"
-                 "    gl_Position = vec4(c * 2.0 - 1.0, 0.0, 1.0);\n"
-                 "}\n";
+    out.vertex = shaders::withVersion(shaders::source("fullscreen.vert"), limits.version);
     for (size_t i = 0; i < plans.size(); ++i) {
         std::sort(plans[i].functions.begin(), plans[i].functions.end());
         DecompressionPass& pass = out.passes[i];

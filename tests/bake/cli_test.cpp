@@ -1,4 +1,4 @@
-// shrefract-bake and shrefract-eval as a user meets them: bad input gets a clear error naming
+// shrefract-bake as a user meets it: bad input gets a clear error naming
 // the file, a non-zero exit and no output file; what is already on disk is kept.
 #include <gtest/gtest.h>
 
@@ -9,38 +9,18 @@
 #include <sstream>
 #include <string>
 
+#include "support/cli_run.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CommandResult {
-    int code;
-    std::string out;  // stdout and stderr together
-};
-
-CommandResult run(const std::string& args) {
-    fs::create_directories(SHREFRACT_TEST_TMP);
-    // One log per test: ctest runs the cases as parallel processes.
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    std::string name = std::string(info->test_suite_name()) + "." + info->name();
-    std::replace(name.begin(), name.end(), '/', '_');
-    std::string log = std::string(SHREFRACT_TEST_TMP) + "/log_" + name + ".txt";
-    int status = std::system((args + " > " + log + " 2>&1").c_str());
-    std::ifstream f(log);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return CommandResult{WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
-}
-
-std::string tmp(const std::string& name) { return std::string(SHREFRACT_TEST_TMP) + "/" + name; }
-
-void write(const std::string& path, const std::string& text) {
-    fs::create_directories(fs::path(path).parent_path());
-    std::ofstream(path) << text;
-}
+using shrefract::test::CommandResult;
+using shrefract::test::run;
+using shrefract::test::tmp;
+const auto& write = shrefract::test::writeText;
 
 const std::string kBake = SHREFRACT_BAKE_EXE;
-const std::string kEval = SHREFRACT_EVAL_EXE;
 constexpr const char* kTetra = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
 
 // Each case: an input file's content (or none), extra arguments, and a word the message needs.
@@ -101,39 +81,6 @@ TEST(BakeCli, BadInputKeepsAnExistingOutputFile) {
     std::string s;
     f >> s;
     EXPECT_EQ(s, "precious");
-}
-
-// A whole small bake, then the evaluation tools on it: the error table, and query answers
-// agreeing with the table's decompression at sample positions.
-TEST(BakeCli, BakesAndEvaluatesATetrahedron) {
-    write(tmp("full_tetra.off"), kTetra);
-    std::string out = tmp("tetra.shrefract.exr");
-    fs::remove(out);
-    CommandResult b = run(kBake + " " + tmp("full_tetra.off") + " -o " + out + " --rate 2 --grid 8x16 --order 4 --cache ''");
-    ASSERT_EQ(b.code, 0) << b.out;
-    EXPECT_NE(b.out.find("samples"), std::string::npos);
-    EXPECT_TRUE(fs::exists(out));
-    CommandResult e = run(kEval + " directions " + out + " --pairs 2000 --json " + tmp("tetra.json"));
-    ASSERT_EQ(e.code, 0) << e.out;
-    EXPECT_NE(e.out.find("median"), std::string::npos);
-    EXPECT_TRUE(fs::exists(tmp("tetra.json")));
-
-    write(tmp("q.csv"), "px,py,pz,wx,wy,wz\n0.2,0.2,0,0,0,-1\n0.1,0,0.1,0,-1,0\n");
-    CommandResult q = run(kEval + " query " + out + " --in " + tmp("q.csv") + " --out " + tmp("a.csv"));
-    ASSERT_EQ(q.code, 0) << q.out;
-    std::ifstream a(tmp("a.csv"));
-    std::string header, line;
-    std::getline(a, header);
-    EXPECT_EQ(header, "ex,ey,ez,len");
-    int rows = 0;
-    while (std::getline(a, line)) ++rows;
-    EXPECT_EQ(rows, 2);
-
-    write(tmp("bad.csv"), "1,2,3\n");
-    CommandResult qb = run(kEval + " query " + out + " --in " + tmp("bad.csv") + " --out " + tmp("b.csv"));
-    EXPECT_NE(qb.code, 0);
-    EXPECT_NE(qb.out.find("bad.csv"), std::string::npos) << qb.out;
-    EXPECT_FALSE(fs::exists(tmp("b.csv")));
 }
 
 }  // namespace

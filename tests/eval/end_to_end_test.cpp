@@ -7,8 +7,8 @@
 #include <memory>
 
 #include "bake/bake.h"
-#include "bake/image_eval.h"
-#include "bake/reference.h"
+#include "eval/image_eval.h"
+#include "eval/reference.h"
 #include "common/latlong.h"
 #include "common/scene.h"
 #include "shrefract/baselines.h"

@@ -6,8 +6,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "bake/image_eval.h"
-#include "bake/reference.h"
+#include "eval/image_eval.h"
+#include "eval/reference.h"
 #include "common/evalbuffer.h"
 #include "common/latlong.h"
 

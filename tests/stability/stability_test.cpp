@@ -8,7 +8,7 @@
 #include <fstream>
 
 #include "bake/bake.h"
-#include "bake/eval.h"
+#include "eval/directions.h"
 #include "common/error.h"
 #include "shrefract/context.h"
 #include "shrefract/render.h"

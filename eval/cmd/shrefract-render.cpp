@@ -4,8 +4,8 @@
 //                    [--out-exr IMG.exr] [--dirs EVAL.exr] [--dump-shaders DIR]
 //                    [--method sh|single|wyman|raytrace] [--wyman-tir reflect|straight|grazing]
 // A thin shell over the runtime library (shrefract/render.h, shrefract/baselines.h) and, for
-// raytrace and Wyman's d_N, the bake library (bake/reference.h): the runtime library itself never
-// links the bake. Bad input: message, exit 1, and no output file.
+// raytrace and Wyman's d_N, the evaluation layer (eval/reference.h, Embree through bake/): the
+// runtime library itself never links the bake. Bad input: message, exit 1, and no output file.
 #include <algorithm>
 #include <cstdio>
 #include <sstream>
@@ -20,10 +20,8 @@
 #include "shrefract/render.h"
 #include "shrefract/runtime.h"
 
-#ifdef SHREFRACT_RENDER_WITH_BAKE
-#include "bake/eval.h"
-#include "bake/reference.h"
-#endif
+#include "eval/directions.h"
+#include "eval/reference.h"
 
 namespace {
 
@@ -131,13 +129,6 @@ int main(int argc, char** argv) {
         double msPerFrame = 0;
         std::string stages;
 
-        if (method == "raytrace" || method == "wyman") {
-#ifndef SHREFRACT_RENDER_WITH_BAKE
-            throw std::invalid_argument("--method " + method +
-                                        " needs the bake library (built with SHREFRACT_BUILD_BAKE)");
-#endif
-        }
-#ifdef SHREFRACT_RENDER_WITH_BAKE
         std::unique_ptr<shrefract::Scene> scene;
         std::unique_ptr<shrefract::Tracer> tracer;
         if (method == "raytrace" || method == "wyman") {
@@ -171,7 +162,6 @@ int main(int argc, char** argv) {
                         stats.geometricNormal, stats.backFacing);
             stages = "CPU wall time, Embree, all cores";
         }
-#endif
         if (method != "raytrace") {
             auto context = shrefract::createHeadlessContext(be, width, height);
             std::printf("GL: %s (%s)\n", context->description().c_str(), shrefract::ToString(be));
@@ -226,12 +216,10 @@ int main(int argc, char** argv) {
                 options.tir = tir;
                 options.loader = context->loader();
                 std::vector<float> normalDistance;
-#ifdef SHREFRACT_RENDER_WITH_BAKE
                 if (tracer) {
                     const auto& L = bake.data().layout;
                     normalDistance = shrefract::normalDistances(*tracer, L.position, L.normal);
                 }
-#endif
                 auto baseline = shrefract::Baseline::create(bake, normalDistance, options);
                 shrefract::renderFrame(*baseline, env, cam, width, height);  // warm-up
                 std::vector<double> back, shade, totals;

@@ -10,8 +10,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "bake/eval.h"
-#include "bake/image_eval.h"
+#include "eval/directions.h"
+#include "eval/image_eval.h"
 #include "common/error.h"
 #include "common/sh.h"
 

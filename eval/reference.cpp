@@ -1,4 +1,4 @@
-#include "bake/reference.h"
+#include "eval/reference.h"
 
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
@@ -79,7 +79,7 @@ EvalBuffer renderReference(const Tracer& tracer, const ReferenceEnvironment& env
                     nCapped += (r.flags & kPathCapped) != 0;
                     nRe += (r.flags & kPathReentered) != 0;
                     nGeo += (r.flags & kPathGeometricNormal) != 0;
-                    // The runtime's shading (runtime/src/glsl.h kShadeFragment), with its
+                    // The runtime's shading (shaders/shade.frag), with its
                     // interpolated normal for the Fresnel term and the reflection.
                     const float eta = static_cast<float>(medium.ior);
                     const float F = FresnelDielectric(glm::dot(ns, omega), eta);

@@ -1,4 +1,4 @@
-#include "bake/image_eval.h"
+#include "eval/image_eval.h"
 
 
 #include <algorithm>
@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "bake/eval.h"
+#include "eval/directions.h"
 #include "common/error.h"
 #include "common/png.h"
 #include "common/tonemap.h"

@@ -1,46 +1,10 @@
-// GLSL of the baselines (runtime/src/baselines.cpp, docs/evaluation.md): single-sided refraction
-// and Wyman 2005. Fresnel, absorption and the environment lookup are the SH shading's
-// (glsl.h kShadingLibrary), so the methods differ only in the exit direction and length.
-#pragma once
-
-namespace shrefract::glsl {
-
-inline const char* kBaselineVertex = R"(#version 330 core
-layout(location = 0) in vec3 aPosition;
-layout(location = 1) in vec3 aNormal;
-layout(location = 2) in float aNormalDistance;  // d_N, object units
-uniform mat4 uModel;
-uniform mat4 uViewProjection;
-uniform mat3 uNormalMatrix;
-out vec3 vPosition;
-out vec3 vNormal;
-out float vNormalDistance;
-void main() {
-    vec4 p = uModel * vec4(aPosition, 1.0);
-    vPosition = p.xyz;
-    vNormal = uNormalMatrix * aNormal;
-    vNormalDistance = aNormalDistance;
-    gl_Position = uViewProjection * p;
-}
-)";
-
-// Wyman pass 1: the nearest back face per pixel: its world normal (outward) and view depth.
-inline const char* kBackFaceFragment = R"(#version 330 core
-uniform mat4 uView;
-in vec3 vPosition;
-in vec3 vNormal;
-in float vNormalDistance;
-layout(location = 0) out vec4 oBack;
-void main() {
-    if (gl_FrontFacing) discard;
-    oBack = vec4(normalize(vNormal), -(uView * vec4(vPosition, 1.0)).z);
-}
-)";
-
-// Front surfaces: refract T1 = refract(-V, N1); single looks T1 up; Wyman finds the second
-// interface: d~ = (thetaT/thetaI) d_V + (1 - thetaT/thetaI) d_N, P2 = P1 + d~ T1, projected into
-// the back-face buffer for N2, then T2 = refract(T1, -N2) (TIR: uTir).
-inline const char* kBaselineFragment = R"(#version 330 core
+#version 330 core
+// Front surfaces of the baselines: T1 = refract(-V, N1); single looks T1 up; Wyman 2005 finds
+// the second interface: d~ = (thetaT/thetaI) d_V + (1 - thetaT/thetaI) d_N, P2 = P1 + d~ T1,
+// projected into the back-face buffer for N2, then T2 = refract(T1, -N2) (TIR: uTir). Fresnel,
+// absorption and the environment lookup are the SH shading's (shading.glsl), so the methods
+// differ only in the exit direction and length.
+#include "shading.glsl"
 uniform samplerCube uEnvironment;
 uniform sampler2D uBack;       // Wyman pass 1 (nearest), viewport-sized
 uniform mat4 uView;
@@ -109,6 +73,3 @@ void main() {
     oColor = vec4(uToneMap ? toneMap(c, uExposure) : c, 1.0);
     oDirection = vec4(exitDir, 1.0);
 }
-)";
-
-}  // namespace shrefract::glsl

@@ -25,22 +25,15 @@
 #include "shrefract/baselines.h"
 #include "shrefract/render.h"
 #include "shrefract/runtime.h"
-#ifdef SHREFRACT_VIEW_WITH_BAKE
-#include "bake/eval.h"
-#include "bake/reference.h"
-#endif
+#include "eval/directions.h"
+#include "eval/reference.h"
 
 namespace {
 
 using namespace shrefract::gl;
 
-// Methods the viewer switches between with M. Wyman needs d_N by ray casting (the bake's
-// Embree), so it is there when the viewer is built with the bake library.
-#ifdef SHREFRACT_VIEW_WITH_BAKE
+// Methods the viewer switches between with M. Wyman's d_N is cast with Embree (eval/reference.h).
 const char* kMethods[] = {"sh", "single", "wyman"};
-#else
-const char* kMethods[] = {"sh", "single"};
-#endif
 
 struct Viewer {
     float azimuth = 30.0f, elevation = 20.0f, distance = 3.0f;
@@ -181,14 +174,12 @@ int main(int argc, char** argv) {
 
         // The other methods share the mesh; Wyman's d_N is cast once here.
         std::vector<float> normalDistance;
-#ifdef SHREFRACT_VIEW_WITH_BAKE
         {
             const shrefract::SurfaceLayout& L = bake.data().layout;
             shrefract::Scene scene = shrefract::sceneOfBake(bake.data(), bakePath);
             shrefract::Tracer tracer(scene, shrefract::traceOptionsOfBake(bake.data()));
             normalDistance = shrefract::normalDistances(tracer, L.position, L.normal);
         }
-#endif
         std::vector<std::unique_ptr<shrefract::Baseline>> baselines;
         for (shrefract::BaselineMethod m : {shrefract::BaselineMethod::Single, shrefract::BaselineMethod::Wyman}) {
             if (m == shrefract::BaselineMethod::Wyman && normalDistance.empty()) break;

@@ -18,9 +18,9 @@
 
 #include "bake/bake.h"
 #include "gl.h"  // glFinish, through the runtime's loader
-#include "bake/image_eval.h"
+#include "eval/image_eval.h"
 #include "bake/layout.h"
-#include "bake/reference.h"
+#include "eval/reference.h"
 #include "common/latlong.h"
 #include "common/sh.h"
 #include "shrefract/baselines.h"

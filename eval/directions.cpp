@@ -1,4 +1,4 @@
-#include "bake/eval.h"
+#include "eval/directions.h"
 
 #include <tbb/parallel_for.h>
 

@@ -1,0 +1,19 @@
+#version 330 core
+// The environment behind everything, looked up along each pixel's view ray.
+#include "shading.glsl"
+uniform samplerCube uEnvironment;
+uniform mat4 uInverseViewProjection;  // rotation-only view
+uniform vec2 uViewport;
+uniform vec2 uViewportOrigin;
+uniform bool uToneMap;
+uniform float uExposure;
+layout(location = 0) out vec4 oColor;
+layout(location = 1) out vec4 oDirection;
+
+void main() {
+    vec2 ndc = (gl_FragCoord.xy - uViewportOrigin) / uViewport * 2.0 - 1.0;
+    vec4 d = uInverseViewProjection * vec4(ndc, 1.0, 1.0);
+    vec3 c = texture(uEnvironment, normalize(d.xyz / d.w)).rgb;
+    oColor = vec4(uToneMap ? toneMap(c, uExposure) : c, 1.0);
+    oDirection = vec4(0.0);
+}

@@ -11,7 +11,9 @@
 
 namespace shrefract {
 
-constexpr int kFormatVersion = 1;
+// 2: per-part and manifest checksums, the layout kind (docs/format.md "Versions"). Readers take
+// version 1 too, unverified.
+constexpr int kFormatVersion = 2;
 
 enum class Precision { F32, F16, U8 };
 const char* ToString(Precision p);
@@ -71,13 +73,24 @@ struct BakeData {
     std::vector<float> u8Scale, u8Offset;  // shEvenCount(order) * 4 each
 
     int coefficientCount() const;  // shEvenCount(order)
+
+    // Not stored: what readBake noticed that the caller should tell the user (e.g. a version 1
+    // file, which carries no checksums).
+    std::vector<std::string> warnings;
+};
+
+struct ReadOptions {
+    // Check every part and the manifest against their checksums (version 2 files). Off: faster,
+    // and a corrupt file may load garbage.
+    bool verify = true;
 };
 
 // Writes to a temporary name beside `path` and renames it when complete: on any failure nothing
 // is left and an existing file at `path` is untouched. Quantizes to `data.precision`.
 void writeBake(const std::string& path, const BakeData& data);
-// Reads and validates; throws InputError naming the file (missing, not a shrefract bake, newer
-// format version than kFormatVersion, inconsistent sizes).
-BakeData readBake(const std::string& path);
+// Reads and validates; throws InputError naming the file and the problem (missing, not a
+// shrefract bake, newer format version than kFormatVersion, a part or the manifest that does not
+// match its checksum, inconsistent sizes).
+BakeData readBake(const std::string& path, const ReadOptions& options = {});
 
 }  // namespace shrefract

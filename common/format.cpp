@@ -6,7 +6,8 @@
 //   "rho"             rho layout  kind a b c (UINT)
 //   "neighbours"      mu layout   offset count (UINT)
 //   "neighbour_list"  near-square index (UINT), weight (FLOAT); entry e at (e % w, e / w)
-// The JSON manifest sits in the string attribute "shrefract.manifest" of every part.
+// The JSON manifest sits in the string attribute "shrefract.manifest" of every part, its XXH3-64
+// in "shrefract.manifestChecksum"; the manifest's "checksums" hold each part's (version 2).
 #include <Iex.h>
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
@@ -36,6 +37,7 @@
 #include <utility>
 
 #include "common/bakefile.h"
+#include "common/checksum.h"
 #include "common/error.h"
 #include "common/sh.h"
 
@@ -67,6 +69,8 @@ namespace {
 using nlohmann::json;
 
 constexpr const char* kManifestAttribute = "shrefract.manifest";
+constexpr const char* kManifestChecksumAttribute = "shrefract.manifestChecksum";
+constexpr const char* kChecksumAlgorithm = "xxh3-64";
 constexpr const char* kWeightsPart = "weights";
 constexpr const char* kSamplesPart = "samples";
 constexpr const char* kRhoPart = "rho";
@@ -143,6 +147,9 @@ public:
         return fb;
     }
     const std::vector<Channel>& channels() const { return channels_; }
+    // The staged bytes: texels row-major, each texel's channels in the order given, each value
+    // little-endian in its pixel type's size. What a part's checksum is taken over.
+    const std::vector<unsigned char>& bytes() const { return bytes_; }
 
 private:
     unsigned char* at(size_t t, int c) { return bytes_.data() + t * stride_ + offset_[c]; }
@@ -332,6 +339,7 @@ Imf::Header partHeader(const char* name, int width, int height, const Imath::Box
     h.setType(Imf::SCANLINEIMAGE);
     h.compression() = Imf::ZIP_COMPRESSION;
     h.insert(kManifestAttribute, Imf::StringAttribute(manifest));
+    h.insert(kManifestChecksumAttribute, Imf::StringAttribute(checksumHex(manifest)));
     return h;
 }
 
@@ -345,39 +353,54 @@ void writeWhole(Imf::MultiPartOutputFile& file, int part, Planes& planes, int he
     out.writePixels(height);
 }
 
-void writeWeights(Imf::MultiPartOutputFile& file, int part, const BakeData& d, const U8Params& u8) {
+// Rows y0 .. y0 + rows - 1 of the weights part, quantized to the bake's precision.
+Planes weightChunk(const BakeData& d, const U8Params& u8, int y0, int rows) {
     const SurfaceLayout& L = d.layout;
     const int K = d.coefficientCount();
     const size_t N = L.position.size();
-    Imf::OutputPart out(file, part);
-    for (int y0 = 0; y0 < L.muHeight; y0 += kChunkRows) {
-        const int rows = std::min(kChunkRows, L.muHeight - y0);
-        Planes chunk(L.muWidth, rows, weightChannels(K, d.precision));
-        for (size_t t = 0; t < size_t(L.muWidth) * rows; ++t) {
-            const size_t i = size_t(y0) * L.muWidth + t;
-            if (i >= N) break;  // texels past the last sample stay zero
-            for (int k = 0; k < K; ++k) {
-                const float* w = &d.weights[(size_t(k) * N + i) * 4];
-                if (d.precision == Precision::U8) {
-                    uint32_t packed = 0;
-                    for (int c = 0; c < 4; ++c)
-                        packed |= quantU8(w[c], u8.scale[k * 4 + c], u8.offset[k * 4 + c])
-                                  << (8 * c);
-                    chunk.setU(t, k, packed);
-                    continue;
-                }
-                for (int c = 0; c < 4; ++c) {
-                    if (!std::isfinite(w[c]))
-                        throw std::invalid_argument(str("writeBake: weight ", k, " of sample ", i,
-                                                        " channel ", kWeightSuffix[c],
-                                                        " is not finite"));
-                    if (d.precision == Precision::F16)
-                        chunk.setH(t, k * 4 + c, w[c]);
-                    else
-                        chunk.setF(t, k * 4 + c, w[c]);
-                }
+    Planes chunk(L.muWidth, rows, weightChannels(K, d.precision));
+    for (size_t t = 0; t < size_t(L.muWidth) * rows; ++t) {
+        const size_t i = size_t(y0) * L.muWidth + t;
+        if (i >= N) break;  // texels past the last sample stay zero
+        for (int k = 0; k < K; ++k) {
+            const float* w = &d.weights[(size_t(k) * N + i) * 4];
+            if (d.precision == Precision::U8) {
+                uint32_t packed = 0;
+                for (int c = 0; c < 4; ++c)
+                    packed |= quantU8(w[c], u8.scale[k * 4 + c], u8.offset[k * 4 + c]) << (8 * c);
+                chunk.setU(t, k, packed);
+                continue;
+            }
+            for (int c = 0; c < 4; ++c) {
+                if (!std::isfinite(w[c]))
+                    throw std::invalid_argument(str("writeBake: weight ", k, " of sample ", i,
+                                                    " channel ", kWeightSuffix[c],
+                                                    " is not finite"));
+                if (d.precision == Precision::F16)
+                    chunk.setH(t, k * 4 + c, w[c]);
+                else
+                    chunk.setF(t, k * 4 + c, w[c]);
             }
         }
+    }
+    return chunk;
+}
+
+// The checksum of the whole weights part, chunk by chunk as it will be written.
+std::string weightsChecksum(const BakeData& d, const U8Params& u8) {
+    Checksum sum;
+    for (int y0 = 0; y0 < d.layout.muHeight; y0 += kChunkRows) {
+        const Planes chunk = weightChunk(d, u8, y0, std::min(kChunkRows, d.layout.muHeight - y0));
+        sum.update(chunk.bytes().data(), chunk.bytes().size());
+    }
+    return sum.hex();
+}
+
+void writeWeights(Imf::MultiPartOutputFile& file, int part, const BakeData& d, const U8Params& u8) {
+    Imf::OutputPart out(file, part);
+    for (int y0 = 0; y0 < d.layout.muHeight; y0 += kChunkRows) {
+        const int rows = std::min(kChunkRows, d.layout.muHeight - y0);
+        Planes chunk = weightChunk(d, u8, y0, rows);
         out.setFrameBuffer(chunk.frameBuffer(y0));
         out.writePixels(rows);
     }
@@ -445,17 +468,64 @@ void checkPart(const Imf::Header& h, const char* name, int width, int height,
     }
 }
 
-void readWhole(Imf::MultiPartInputFile& file, int part, Planes& planes, int height) {
+// What a version 2 file says its parts' checksums are, and the check against what was read.
+class Verifier {
+public:
+    Verifier(const json& manifest, bool on) : on_(on) {
+        if (!on_) return;
+        auto it = manifest.find("checksums");
+        if (it == manifest.end() || !it->is_object() || it->value("algorithm", "") != kChecksumAlgorithm ||
+            !it->contains("parts") || !(*it)["parts"].is_object())
+            throw InputError(str("manifest has no \"checksums\" of algorithm ", kChecksumAlgorithm));
+        parts_ = (*it)["parts"];
+    }
+    bool on() const { return on_; }
+    void check(const char* part, const std::string& actual) const {
+        if (!on_) return;
+        auto it = parts_.find(part);
+        if (it == parts_.end() || !it->is_string())
+            throw InputError(str("manifest has no checksum for part \"", part, "\""));
+        if (it->get<std::string>() != actual)
+            throw InputError(str("part \"", part, "\" is corrupt: its data do not match its checksum (",
+                                 it->get<std::string>(), " recorded, ", actual, " read)"));
+    }
+
+private:
+    bool on_;
+    json parts_;
+};
+
+void readWhole(Imf::MultiPartInputFile& file, int part, Planes& planes, int height,
+               const Verifier& verifier, const char* name) {
     Imf::InputPart in(file, part);
     in.setFrameBuffer(planes.frameBuffer(0));
     in.readPixels(0, height - 1);
+    if (verifier.on()) verifier.check(name, checksumHex(planes.bytes().data(), planes.bytes().size()));
 }
 
-BakeData readParts(Imf::MultiPartInputFile& file) {
-    // The manifest of the first part is the one that counts.
+// The manifest text of part 0, checked against its checksum and the copies in the other parts.
+std::string manifestText(Imf::MultiPartInputFile& file, int version, bool verify) {
     const auto* text = file.header(0).findTypedAttribute<Imf::StringAttribute>(kManifestAttribute);
     if (!text) throw InputError("not a shrefract bake (no \"shrefract.manifest\" attribute)");
-    json m = json::parse(text->value(), nullptr, /*allow_exceptions=*/false);
+    if (version < 2 || !verify) return text->value();
+    const auto* sum = file.header(0).findTypedAttribute<Imf::StringAttribute>(kManifestChecksumAttribute);
+    if (!sum) throw InputError("the manifest has no checksum (\"shrefract.manifestChecksum\")");
+    if (sum->value() != checksumHex(text->value()))
+        throw InputError("the manifest is corrupt: it does not match its checksum");
+    for (int p = 1; p < file.parts(); ++p) {
+        const auto* copy = file.header(p).findTypedAttribute<Imf::StringAttribute>(kManifestAttribute);
+        if (!copy || copy->value() != text->value())
+            throw InputError(str("the manifest copy in part ", p, " differs from part 0's: the file is corrupt"));
+    }
+    return text->value();
+}
+
+BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
+    // The manifest of the first part is the one that counts. Its version decides how it is
+    // verified, so it is parsed once unverified, then taken again through its checksum.
+    const auto* raw = file.header(0).findTypedAttribute<Imf::StringAttribute>(kManifestAttribute);
+    if (!raw) throw InputError("not a shrefract bake (no \"shrefract.manifest\" attribute)");
+    json m = json::parse(raw->value(), nullptr, /*allow_exceptions=*/false);
     if (m.is_discarded() || !m.is_object())
         throw InputError("not a shrefract bake (the manifest is not a JSON object)");
     if (!m.contains("format") || m["format"] != "shrefract")
@@ -465,6 +535,20 @@ BakeData readParts(Imf::MultiPartInputFile& file) {
         throw InputError(str("format version ", version, " is newer than this build reads (",
                              kFormatVersion, ")"));
     if (version < 1) throw InputError(str("format version ", version, " is invalid"));
+    manifestText(file, version, options.verify);
+    std::vector<std::string> warnings;
+    if (version < 2)
+        warnings.push_back(str("format version ", version,
+                               " carries no checksums: its data cannot be verified (re-bake to get "
+                               "version ", kFormatVersion, ")"));
+    const Verifier verifier(m, options.verify && version >= 2);
+    if (version >= 2) {
+        auto layout = m.find("layout");
+        if (layout == m.end() || !layout->is_object() || !layout->contains("kind"))
+            throw InputError("manifest has no \"layout\" kind");
+        if ((*layout)["kind"] != "joining")
+            throw InputError(str("unknown layout kind ", (*layout)["kind"].dump()));
+    }
 
     BakeData d;
     d.order = manifestInt(m, "order");
@@ -527,15 +611,19 @@ BakeData readParts(Imf::MultiPartInputFile& file) {
         throw InputError(str("neighbour list of ", nlLength, " entries does not fit its ", nlWidth,
                              " x ", nlHeight, " part"));
 
-    // Weights, a band of rows at a time, dequantized to float.
+    // Weights, a band of rows at a time, dequantized to float. Verified, every row is read (the
+    // checksum covers the padding past the last sample too).
     d.weights.assign(size_t(K) * N * 4, 0.0f);
     {
         Imf::InputPart in(file, pWeights);
-        for (int y0 = 0; y0 < L.muHeight && int64_t(y0) * L.muWidth < N; y0 += kChunkRows) {
+        Checksum sum;
+        for (int y0 = 0; y0 < L.muHeight && (verifier.on() || int64_t(y0) * L.muWidth < N);
+             y0 += kChunkRows) {
             const int rows = std::min(kChunkRows, L.muHeight - y0);
             Planes chunk(L.muWidth, rows, wChannels);
             in.setFrameBuffer(chunk.frameBuffer(y0));
             in.readPixels(y0, y0 + rows - 1);
+            sum.update(chunk.bytes().data(), chunk.bytes().size());
             for (size_t t = 0; t < size_t(L.muWidth) * rows; ++t) {
                 const size_t i = size_t(y0) * L.muWidth + t;
                 if (i >= size_t(N)) break;
@@ -554,12 +642,13 @@ BakeData readParts(Imf::MultiPartInputFile& file) {
                 }
             }
         }
+        verifier.check(kWeightsPart, sum.hex());
     }
 
     Planes samples(L.muWidth, L.muHeight, kSampleChannels);
-    readWhole(file, pSamples, samples, L.muHeight);
+    readWhole(file, pSamples, samples, L.muHeight, verifier, kSamplesPart);
     Planes neighbours(L.muWidth, L.muHeight, kNeighbourChannels);
-    readWhole(file, pNeighbours, neighbours, L.muHeight);
+    readWhole(file, pNeighbours, neighbours, L.muHeight, verifier, kNeighboursPart);
     L.position.resize(N);
     L.normal.resize(N);
     L.part.resize(N);
@@ -574,13 +663,13 @@ BakeData readParts(Imf::MultiPartInputFile& file) {
     }
 
     Planes rhoPlanes(L.rhoWidth, L.rhoHeight, kRhoChannels);
-    readWhole(file, pRho, rhoPlanes, L.rhoHeight);
+    readWhole(file, pRho, rhoPlanes, L.rhoHeight, verifier, kRhoPart);
     L.rho.resize(size_t(L.rhoWidth) * L.rhoHeight);
     for (size_t t = 0; t < L.rho.size(); ++t)
         L.rho[t] = {rhoPlanes.u(t, 0), rhoPlanes.u(t, 1), rhoPlanes.u(t, 2), rhoPlanes.u(t, 3)};
 
     Planes list(nlWidth, nlHeight, kNeighbourListChannels);
-    readWhole(file, pList, list, nlHeight);
+    readWhole(file, pList, list, nlHeight, verifier, kNeighbourListPart);
     L.neighbourIndex.resize(nlLength);
     L.neighbourWeight.resize(nlLength);
     for (int e = 0; e < nlLength; ++e) {
@@ -591,6 +680,7 @@ BakeData readParts(Imf::MultiPartInputFile& file) {
     const std::string problem = inconsistency(d);
     if (!problem.empty()) throw InputError("inconsistent bake: " + problem);
     d.manifest = std::move(m);
+    d.warnings = std::move(warnings);
     return d;
 }
 
@@ -606,6 +696,33 @@ void writeBake(const std::string& path, const BakeData& data) {
     const U8Params u8 = data.precision == Precision::U8 ? fitU8(data) : U8Params{};
     const auto [nlWidth, nlHeight] = neighbourListSize(L.neighbourIndex.size());
 
+    // The parts' pixels are staged first: their checksums go into the manifest, which every
+    // part's header carries.
+    Planes samples(L.muWidth, L.muHeight, kSampleChannels);
+    Planes neighbours(L.muWidth, L.muHeight, kNeighbourChannels);
+    for (int i = 0; i < L.sampleCount(); ++i) {
+        for (int c = 0; c < 3; ++c) {
+            samples.setF(i, c, L.position[i][c]);
+            samples.setF(i, 3 + c, L.normal[i][c]);
+        }
+        samples.setU(i, 6, L.part[i]);
+        neighbours.setU(i, 0, L.neighbourOffset[i]);
+        neighbours.setU(i, 1, L.neighbourCount[i]);
+    }
+    Planes rho(L.rhoWidth, L.rhoHeight, kRhoChannels);
+    for (size_t t = 0; t < L.rho.size(); ++t) {
+        rho.setU(t, 0, L.rho[t].kind);
+        rho.setU(t, 1, L.rho[t].a);
+        rho.setU(t, 2, L.rho[t].b);
+        rho.setU(t, 3, L.rho[t].c);
+    }
+    Planes list(nlWidth, nlHeight, kNeighbourListChannels);
+    for (size_t e = 0; e < L.neighbourIndex.size(); ++e) {
+        list.setU(e, 0, L.neighbourIndex[e]);
+        list.setF(e, 1, L.neighbourWeight[e]);
+    }
+    auto sum = [](const Planes& p) { return checksumHex(p.bytes().data(), p.bytes().size()); };
+
     json m = data.manifest.is_null() ? json::object() : data.manifest;
     m["format"] = "shrefract";
     m["version"] = kFormatVersion;
@@ -620,10 +737,18 @@ void writeBake(const std::string& path, const BakeData& data) {
     m["rate"] = L.rate;
     m["neighbourListWidth"] = nlWidth;
     m["neighbourListLength"] = L.neighbourIndex.size();
+    m["layout"] = {{"kind", "joining"}};
     if (data.precision == Precision::U8)
         m["u8"] = {{"scale", u8.scale}, {"offset", u8.offset}};
     else
         m.erase("u8");
+    m["checksums"] = {{"algorithm", kChecksumAlgorithm},
+                      {"parts",
+                       {{kWeightsPart, weightsChecksum(data, u8)},
+                        {kSamplesPart, sum(samples)},
+                        {kRhoPart, sum(rho)},
+                        {kNeighboursPart, sum(neighbours)},
+                        {kNeighbourListPart, sum(list)}}}};
     std::string text;
     try {
         text = m.dump();
@@ -652,35 +777,9 @@ void writeBake(const std::string& path, const BakeData& data) {
             Imf::StdOFStream stream(os, tmp.c_str());
             Imf::MultiPartOutputFile file(stream, headers.data(), int(headers.size()));
             writeWeights(file, 0, data, u8);
-
-            Planes samples(L.muWidth, L.muHeight, kSampleChannels);
-            Planes neighbours(L.muWidth, L.muHeight, kNeighbourChannels);
-            for (int i = 0; i < L.sampleCount(); ++i) {
-                for (int c = 0; c < 3; ++c) {
-                    samples.setF(i, c, L.position[i][c]);
-                    samples.setF(i, 3 + c, L.normal[i][c]);
-                }
-                samples.setU(i, 6, L.part[i]);
-                neighbours.setU(i, 0, L.neighbourOffset[i]);
-                neighbours.setU(i, 1, L.neighbourCount[i]);
-            }
             writeWhole(file, 1, samples, L.muHeight);
-
-            Planes rho(L.rhoWidth, L.rhoHeight, kRhoChannels);
-            for (size_t t = 0; t < L.rho.size(); ++t) {
-                rho.setU(t, 0, L.rho[t].kind);
-                rho.setU(t, 1, L.rho[t].a);
-                rho.setU(t, 2, L.rho[t].b);
-                rho.setU(t, 3, L.rho[t].c);
-            }
             writeWhole(file, 2, rho, L.rhoHeight);
             writeWhole(file, 3, neighbours, L.muHeight);
-
-            Planes list(nlWidth, nlHeight, kNeighbourListChannels);
-            for (size_t e = 0; e < L.neighbourIndex.size(); ++e) {
-                list.setU(e, 0, L.neighbourIndex[e]);
-                list.setF(e, 1, L.neighbourWeight[e]);
-            }
             writeWhole(file, 4, list, nlHeight);
         }  // the destructor writes the chunk offset tables; it swallows errors, the stream not
         os.flush();
@@ -699,7 +798,7 @@ void writeBake(const std::string& path, const BakeData& data) {
     }
 }
 
-BakeData readBake(const std::string& path) {
+BakeData readBake(const std::string& path, const ReadOptions& options) {
     std::error_code ec;
     const auto status = std::filesystem::status(path, ec);
     if (!std::filesystem::exists(status)) throw inputError(path, "file not found");
@@ -713,7 +812,7 @@ BakeData readBake(const std::string& path) {
         throw inputError(path, str("not an OpenEXR file: ", e.what()));
     }
     try {
-        return readParts(*file);
+        return readParts(*file, options);
     } catch (const InputError& e) {
         throw inputError(path, e.what());
     } catch (const Iex::BaseExc& e) {

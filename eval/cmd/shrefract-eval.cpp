@@ -65,6 +65,7 @@ int main(int argc, char** argv) {
     size_t pairs = 100000;
     uint64_t seed = 1;
     int order = -1;
+    bool noVerify = false;
     auto* dirs = app.add_subcommand("directions", "random (sample, direction) pairs against fresh traces");
     dirs->add_option("bake", bakePath, "NAME.shrefract.exr")->required();
     dirs->add_option("--pairs", pairs, "number of pairs")->capture_default_str()->check(CLI::Range(size_t(1), size_t(100'000'000)));
@@ -72,6 +73,7 @@ int main(int argc, char** argv) {
     dirs->add_option("--order", order, "evaluate with bands 0..order only (default: all stored)");
     dirs->add_option("--json", jsonPath, "write the report here");
     dirs->add_option("--scene", scenePath, "the baked mesh or scene, if not where the manifest says");
+    dirs->add_flag("--no-verify", noVerify, "skip the bake's checksums");
     std::string tolText = "0.5,1,2,5,10";
     auto* adaptive = app.add_subcommand(
         "adaptive", "would a per-sample order pay? memory saved and error against fresh traces");
@@ -152,7 +154,11 @@ int main(int argc, char** argv) {
             std::printf("montage of %zu -> %s\n", buffers.size(), outPng.c_str());
             return 0;
         }
-        BakeData bake = readBake(bakePath);
+        ReadOptions readOptions;
+        readOptions.verify = !noVerify;
+        BakeData bake = readBake(bakePath, readOptions);
+        for (const std::string& w : bake.warnings)
+            std::fprintf(stderr, "shrefract-eval: warning: %s: %s\n", bakePath.c_str(), w.c_str());
         if (adaptive->parsed()) {
             Scene scene = sceneOfBake(bake, bakePath, scenePath);
             const size_t n = bake.layout.position.size();

@@ -59,7 +59,7 @@ int main(int argc, char** argv) {
     int order = -1, frames = 5;
     bool smoothing = false;
     std::string method = "sh", wymanTir = "reflect", scenePath;
-    bool latLongLookup = false;
+    bool latLongLookup = false, noVerify = false;
     app.add_option("bake", bakePath, "NAME.shrefract.exr from shrefract-bake")->required();
     app.add_option("--env", envPath, "lat-long environment EXR")->required();
     app.add_option("--camera", camera, "orbit:AZ,EL,DIST (degrees, degrees, object units)");
@@ -90,6 +90,7 @@ int main(int argc, char** argv) {
     app.add_option("--scene", scenePath,
                    "raytrace, wyman: the baked mesh or scene, if not where the manifest says");
     app.add_option("--dump-shaders", dumpDir, "write the generated GLSL into DIR");
+    app.add_flag("--no-verify", noVerify, "skip the bake's checksums (faster; a corrupt file may draw garbage)");
     CLI11_PARSE(app, argc, argv);
 
     try {
@@ -122,7 +123,9 @@ int main(int argc, char** argv) {
         const shrefract::WymanTir tir = shrefract::parseWymanTir(wymanTir);
 
         // Input first (cheap, and the common failure), then the context.
-        shrefract::Bake bake = shrefract::loadBake(bakePath);
+        shrefract::Bake bake = shrefract::loadBake(bakePath, !noVerify);
+        for (const std::string& w : bake.warnings())
+            std::fprintf(stderr, "shrefract-render: warning: %s: %s\n", bakePath.c_str(), w.c_str());
         shrefract::RenderedFrame frame;
         frame.width = width;
         frame.height = height;

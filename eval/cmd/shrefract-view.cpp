@@ -112,7 +112,7 @@ int main(int argc, char** argv) {
     std::string bakePath, envPath, size = "1024x768", preset = "modern", screenshotPath;
     int order = -1, frames = 0;
     float exposure = 1.0f;
-    bool smoothing = false, noObject = false;
+    bool smoothing = false, noObject = false, noVerify = false;
     app.add_option("bake", bakePath, "NAME.shrefract.exr from shrefract-bake")->required();
     app.add_option("--env", envPath, "lat-long environment EXR")->required();
     app.add_option("--size", size, "window size WxH")->capture_default_str();
@@ -123,6 +123,7 @@ int main(int argc, char** argv) {
     app.add_option("--screenshot", screenshotPath, "save the last frame here and exit (with --frames)");
     app.add_option("--frames", frames, "render N frames, then exit (0: run until Esc)");
     app.add_flag("--no-object", noObject, "draw the environment only (a reference for tests)");
+    app.add_flag("--no-verify", noVerify, "skip the bake's checksums (faster; a corrupt file may draw garbage)");
     std::string startMethod = "sh";
     app.add_option("--method", startMethod, "method at start (M cycles): sh | single | wyman")
         ->capture_default_str();
@@ -161,7 +162,9 @@ int main(int argc, char** argv) {
         ensureLoaded(reinterpret_cast<Loader>(&glfwGetProcAddress));
         std::printf("GL: %s, %s\n", reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
                     reinterpret_cast<const char*>(glGetString(GL_VERSION)));
-        shrefract::Bake bake = shrefract::loadBake(bakePath);
+        shrefract::Bake bake = shrefract::loadBake(bakePath, !noVerify);
+        for (const std::string& w : bake.warnings())
+            std::fprintf(stderr, "shrefract-view: warning: %s: %s\n", bakePath.c_str(), w.c_str());
         shrefract::Environment env = shrefract::Environment::loadLatLong(envPath);
         shrefract::RefractorOptions options;
         options.preset = preset;

@@ -4,7 +4,11 @@
 
 namespace shrefract {
 
-Bake loadBake(const std::string& path) { return makeBake(readBake(path)); }
+Bake loadBake(const std::string& path, bool verify) {
+    ReadOptions options;
+    options.verify = verify;
+    return makeBake(readBake(path, options));
+}
 
 Bake makeBake(BakeData data) {
     Bake b;
@@ -17,6 +21,7 @@ const BakeData& Bake::data() const {
     return *data_;
 }
 int Bake::order() const { return data().order; }
+const std::vector<std::string>& Bake::warnings() const { return data().warnings; }
 int Bake::sampleCount() const { return data().layout.sampleCount(); }
 int Bake::triangleCount() const { return data().layout.triangleCount; }
 

@@ -18,11 +18,13 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <map>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "common/bakefile.h"
+#include "common/checksum.h"
 #include "common/error.h"
 #include "common/sh.h"
 
@@ -145,46 +147,91 @@ void expectLayoutEqual(const SurfaceLayout& a, const SurfaceLayout& b) {
     EXPECT_EQ(a.neighbourWeight, b.neighbourWeight);
 }
 
+// The channels of each part in the order docs/format.md gives them, which is the order a part's
+// checksum takes them in (texels row-major, each texel's channels in this order).
+std::vector<std::string> documentedChannels(const std::string& part, const Imf::Header& h) {
+    if (part == "samples") return {"P.x", "P.y", "P.z", "N.x", "N.y", "N.z", "part"};
+    if (part == "rho") return {"kind", "a", "b", "c"};
+    if (part == "neighbours") return {"offset", "count"};
+    if (part == "neighbour_list") return {"index", "weight"};
+    std::vector<std::string> names;  // weights: w000.x, w000.y, w000.z, w000.len, w001.x, ...
+    for (int k = 0;; ++k) {
+        char base[16];
+        std::snprintf(base, sizeof base, "w%03d.", k);
+        if (h.channels().findChannel(std::string(base) + "rgba8")) {
+            names.push_back(std::string(base) + "rgba8");
+        } else if (h.channels().findChannel(std::string(base) + "x")) {
+            for (const char* c : {"x", "y", "z", "len"}) names.push_back(std::string(base) + c);
+        } else {
+            return names;
+        }
+    }
+}
+
 // Copies a bake part by part, channel by channel, letting the test edit the manifest (of every
-// part) and the raw pixels: a way to make files that writeBake would never write.
+// part) and the raw pixels: a way to make files that writeBake would never write. With `resign`
+// the copy gets the checksums of what it holds (the part checksums and the manifest's, computed
+// here from docs/format.md), so that only the edited content can make it wrong; without, the
+// old checksums stay: a corrupt file.
 using PixelEdit = std::function<void(const std::string& part, const std::string& channel,
                                      std::vector<char>& bytes)>;
 void rewrite(const fs::path& src, const fs::path& dst, const std::function<void(json&)>& edit,
-             const PixelEdit& pixels = nullptr) {
+             const PixelEdit& pixels = nullptr, bool resign = true) {
     Imf::MultiPartInputFile in(src.c_str());
     std::vector<Imf::Header> headers;
+    std::vector<std::map<std::string, std::vector<char>>> planes(in.parts());
+    json sums = json::object();
     for (int p = 0; p < in.parts(); ++p) {
-        Imf::Header h = in.header(p);
+        headers.push_back(in.header(p));
+        const Imf::Header& h = headers.back();
+        const Imath::Box2i dw = h.dataWindow();
+        const int w = dw.max.x + 1, ht = dw.max.y + 1;
+        Imf::FrameBuffer fb;
+        for (auto c = h.channels().begin(); c != h.channels().end(); ++c) {
+            const size_t size = c.channel().type == Imf::HALF ? 2 : 4;
+            auto& bytes = planes[p][c.name()];
+            bytes.resize(size * w * ht);
+            fb.insert(c.name(), Imf::Slice(c.channel().type, bytes.data(), size, size * w));
+        }
+        Imf::InputPart ip(in, p);
+        ip.setFrameBuffer(fb);
+        ip.readPixels(0, ht - 1);
+        if (pixels)
+            for (auto& [name, bytes] : planes[p]) pixels(h.name(), name, bytes);
+        // Interleave in the documented order for the checksum.
+        const std::vector<std::string> order = documentedChannels(h.name(), h);
+        std::string staged;
+        for (size_t t = 0; t < size_t(w) * ht; ++t)
+            for (const std::string& c : order) {
+                const auto& bytes = planes[p].at(c);
+                const size_t size = bytes.size() / (size_t(w) * ht);
+                staged.append(&bytes[t * size], size);
+            }
+        sums[h.name()] = checksumHex(staged);
+    }
+    for (Imf::Header& h : headers) {
         auto& attr = h.typedAttribute<Imf::StringAttribute>("shrefract.manifest");
         json m = json::parse(attr.value());
+        if (resign && m.contains("checksums")) m["checksums"]["parts"] = sums;
         edit(m);
         attr.value() = m.dump();
-        headers.push_back(h);
+        if (resign && h.findTypedAttribute<Imf::StringAttribute>("shrefract.manifestChecksum"))
+            h.typedAttribute<Imf::StringAttribute>("shrefract.manifestChecksum").value() =
+                checksumHex(attr.value());
     }
     Imf::MultiPartOutputFile out(dst.c_str(), headers.data(), int(headers.size()));
     for (int p = 0; p < in.parts(); ++p) {
         const Imath::Box2i dw = headers[p].dataWindow();
-        const int w = dw.max.x + 1, h = dw.max.y + 1;
-        std::vector<std::pair<std::string, std::vector<char>>> planes;
+        const int w = dw.max.x + 1, ht = dw.max.y + 1;
         Imf::FrameBuffer fb;
         for (auto c = headers[p].channels().begin(); c != headers[p].channels().end(); ++c) {
-            const size_t size = c.channel().type == Imf::HALF ? 2 : 4;
-            planes.emplace_back(c.name(), std::vector<char>(size * w * h));
+            auto& bytes = planes[p][c.name()];
+            const size_t size = bytes.size() / (size_t(w) * ht);
+            fb.insert(c.name(), Imf::Slice(c.channel().type, bytes.data(), size, size * w));
         }
-        auto c = headers[p].channels().begin();
-        for (auto& [name, bytes] : planes) {
-            const size_t size = bytes.size() / (size_t(w) * h);
-            fb.insert(name, Imf::Slice(c.channel().type, bytes.data(), size, size * w));
-            ++c;
-        }
-        Imf::InputPart ip(in, p);
-        ip.setFrameBuffer(fb);
-        ip.readPixels(0, h - 1);
-        if (pixels)
-            for (auto& [name, bytes] : planes) pixels(headers[p].name(), name, bytes);
         Imf::OutputPart op(out, p);
         op.setFrameBuffer(fb);
-        op.writePixels(h);
+        op.writePixels(ht);
     }
 }
 
@@ -552,6 +599,144 @@ TEST(Format, WeightBytesPerTexelPerCoefficient) {
     EXPECT_GT(perTexel[0], perTexel[1]);
     EXPECT_GT(perTexel[1], perTexel[2]);
     EXPECT_LE(perTexel[0], 16.5);  // never much above the uncompressed 16 bytes
+}
+
+}  // namespace
+}  // namespace shrefract
+
+namespace shrefract {
+namespace {
+
+bool sameData(const BakeData& a, const BakeData& b) {
+    return a.order == b.order && a.precision == b.precision && a.weights == b.weights &&
+           a.u8Scale == b.u8Scale && a.u8Offset == b.u8Offset &&
+           a.layout.position == b.layout.position && a.layout.normal == b.layout.normal &&
+           a.layout.part == b.layout.part && a.layout.rho.size() == b.layout.rho.size() &&
+           std::equal(a.layout.rho.begin(), a.layout.rho.end(), b.layout.rho.begin(),
+                      [](const RhoTexel& x, const RhoTexel& y) {
+                          return x.kind == y.kind && x.a == y.a && x.b == y.b && x.c == y.c;
+                      }) &&
+           a.layout.neighbourOffset == b.layout.neighbourOffset &&
+           a.layout.neighbourCount == b.layout.neighbourCount &&
+           a.layout.neighbourIndex == b.layout.neighbourIndex &&
+           a.layout.neighbourWeight == b.layout.neighbourWeight && a.manifest == b.manifest;
+}
+
+// One value changed in one part, checksums left as written: the reader names that part. With
+// verification off the same file loads (so it is the checksum that refuses it).
+TEST(Format, EveryPartIsCheckedAgainstItsChecksum) {
+    const fs::path dir = scratch();
+    const fs::path ok = dir / "ok.shrefract.exr";
+    writeBake(ok.string(), syntheticBake(Precision::F16));
+    const std::pair<const char*, const char*> targets[] = {
+        {"weights", "w003.y"}, {"samples", "N.x"}, {"rho", "kind"},
+        {"neighbours", "count"}, {"neighbour_list", "weight"}};
+    for (const auto& [part, channel] : targets) {
+        const fs::path bad = dir / (std::string(part) + ".shrefract.exr");
+        rewrite(
+            ok, bad, [](json&) {},
+            [&, part = part, channel = channel](const std::string& p, const std::string& c,
+                                                std::vector<char>& bytes) {
+                // Flip the lowest bit of the first value: consistent, only the checksum sees it.
+                if (p == part && c == channel) bytes[0] ^= 1;
+            },
+            /*resign=*/false);
+        expectInputError(bad, std::string("part \"") + part + "\" is corrupt");
+        ReadOptions fast;
+        fast.verify = false;
+        EXPECT_NO_THROW(readBake(bad.string(), fast)) << part;
+    }
+}
+
+TEST(Format, ManifestIsCheckedAgainstItsChecksum) {
+    const fs::path dir = scratch();
+    const fs::path ok = dir / "ok.shrefract.exr";
+    writeBake(ok.string(), syntheticBake(Precision::F32));
+    rewrite(ok, dir / "ior.shrefract.exr", [](json& m) { m["media"][0]["ior"] = 1.7; }, nullptr,
+            /*resign=*/false);
+    expectInputError(dir / "ior.shrefract.exr", "the manifest is corrupt");
+    // Resigned, the same edit is a valid file: the checksum was the only objection.
+    rewrite(ok, dir / "ior2.shrefract.exr", [](json& m) { m["media"][0]["ior"] = 1.7; });
+    EXPECT_DOUBLE_EQ(readBake((dir / "ior2.shrefract.exr").string()).manifest["media"][0]["ior"], 1.7);
+    // A copy in another part that disagrees with part 0's (the edit is called once per part).
+    int call = 0;
+    rewrite(ok, dir / "copy.shrefract.exr",
+            [&](json& m) {
+                if (call++ == 3) m["media"][0]["name"] = "Glass";
+            },
+            nullptr, /*resign=*/false);
+    expectInputError(dir / "copy.shrefract.exr", "the manifest copy in part 3 differs");
+}
+
+// A file written by format version 1 (tests/data/icosphere_v1.shrefract.exr, made by the v1
+// shrefract-bake: icosphere, rate 1, order 2, 8x16 grid, u8) still loads, with a warning that
+// nothing in it can be verified.
+TEST(Format, Version1FilesLoadUnverifiedWithAWarning) {
+    const BakeData d = readBake(SHREFRACT_TEST_DATA "/icosphere_v1.shrefract.exr");
+    EXPECT_EQ(d.manifest["version"], 1);
+    EXPECT_EQ(d.order, 2);
+    EXPECT_EQ(d.precision, Precision::U8);
+    EXPECT_EQ(d.layout.sampleCount(), 642);
+    EXPECT_EQ(d.layout.triangleCount, 1280);
+    ASSERT_EQ(d.warnings.size(), 1u);
+    EXPECT_NE(d.warnings[0].find("version 1 carries no checksums"), std::string::npos) << d.warnings[0];
+    // Band 0 is the mean over the sphere of views (w_0 y_0^0): the mean of unit exit directions
+    // is no longer than 1 (u8 steps allowed), and a mean path length is positive.
+    const float y00 = 0.282094792f;  // y_0^0
+    for (int i = 0; i < d.layout.sampleCount(); ++i) {
+        const float* w = &d.weights[size_t(i) * 4];
+        EXPECT_LE(glm::length(glm::vec3(w[0], w[1], w[2])) * y00, 1.0f + 1e-2f) << i;
+        EXPECT_GT(w[3] * y00, 0.0f) << i;
+    }
+    // Written again it is version 2, verified, and the same data.
+    const fs::path dir = scratch();
+    writeBake((dir / "v2.shrefract.exr").string(), d);
+    const BakeData again = readBake((dir / "v2.shrefract.exr").string());
+    EXPECT_EQ(again.manifest["version"], kFormatVersion);
+    EXPECT_TRUE(again.warnings.empty());
+    EXPECT_EQ(again.weights, d.weights);
+}
+
+// Random damage, seeded: 1000 files, each with 1 to 8 bytes flipped at random places or cut
+// short. Each must be refused with an InputError, or load data identical to the original (the
+// flip hit bytes the data do not depend on). Never a crash, never different data.
+TEST(Format, RandomCorruptionIsRefusedOrHarmless) {
+    const fs::path dir = scratch();
+    const fs::path ok = dir / "ok.shrefract.exr";
+    for (Precision precision : {Precision::F32, Precision::U8}) {
+        writeBake(ok.string(), syntheticBake(precision));
+        const BakeData original = readBake(ok.string());
+        const std::string bytes = readBytes(ok);
+        std::mt19937 rng(precision == Precision::F32 ? 1 : 2);
+        int refused = 0, harmless = 0, truncations = 0;
+        for (int trial = 0; trial < 500; ++trial) {
+            std::string damaged = bytes;
+            if (trial % 10 == 9) {
+                damaged.resize(std::uniform_int_distribution<size_t>(0, bytes.size() - 1)(rng));
+                ++truncations;
+            } else {
+                const int flips = std::uniform_int_distribution<int>(1, 8)(rng);
+                for (int f = 0; f < flips; ++f) {
+                    const size_t at = std::uniform_int_distribution<size_t>(0, bytes.size() - 1)(rng);
+                    damaged[at] = char(damaged[at] ^ (1 << std::uniform_int_distribution<int>(0, 7)(rng)));
+                }
+            }
+            const fs::path bad = dir / "bad.shrefract.exr";
+            writeBytes(bad, damaged);
+            try {
+                const BakeData d = readBake(bad.string());
+                EXPECT_TRUE(sameData(d, original)) << "trial " << trial << " loaded different data";
+                ++harmless;
+            } catch (const InputError& e) {
+                EXPECT_NE(std::string(e.what()).find(bad.string()), std::string::npos) << e.what();
+                ++refused;
+            }
+        }
+        std::printf("[ damage   ] %s: %d refused, %d harmless (%d truncations)\n", ToString(precision),
+                    refused, harmless, truncations);
+        EXPECT_EQ(refused + harmless, 500);
+        EXPECT_GT(refused, 400);  // most bytes of a small file are data, offsets or the manifest
+    }
 }
 
 }  // namespace

@@ -22,6 +22,9 @@ public:
     int triangleCount() const;
     float ior() const;          // manifest media[0].ior, else 1.5
     glm::vec3 absorption() const;  // manifest media[0].absorption (kappa per RGB), else 0
+    // What loading noticed that the app should show its user, e.g. an older format version
+    // whose data cannot be verified.
+    const std::vector<std::string>& warnings() const;
     const BakeData& data() const;
 
 private:
@@ -29,8 +32,10 @@ private:
     std::shared_ptr<const BakeData> data_;
 };
 
-// Reads NAME.shrefract.exr; throws InputError naming the file (missing, corrupt, newer format).
-Bake loadBake(const std::string& path);
+// Reads NAME.shrefract.exr and checks every part against its checksum (`verify` false skips
+// that: faster, but a corrupt file may then draw garbage); throws InputError naming the file
+// and the problem (missing, corrupt, newer format).
+Bake loadBake(const std::string& path, bool verify = true);
 // Wraps bake data already in memory (tests, tools that bake and render in one process).
 Bake makeBake(BakeData data);
 

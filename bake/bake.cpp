@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 
 #include "bake/layout.h"
+#include "common/error.h"
 #include "common/frame.h"
 #include "common/sh.h"
 
@@ -29,6 +30,24 @@ double secondsSince(Clock::time_point t0) {
 constexpr int kBatch = 32;
 
 }  // namespace
+
+const char* ToString(Fit fit) {
+    switch (fit) {
+        case Fit::Projection:
+            return "projection";
+        case Fit::LeastSquares:
+            return "lsq";
+        case Fit::Weighted:
+            return "weighted";
+    }
+    return "unknown";
+}
+
+Fit parseFit(const std::string& text) {
+    for (Fit f : {Fit::Projection, Fit::LeastSquares, Fit::Weighted})
+        if (text == ToString(f)) return f;
+    throw InputError("unknown fit \"" + text + "\" (expected projection, lsq or weighted)");
+}
 
 std::vector<int> evenBands(int L) {
     std::vector<int> bands;
@@ -55,14 +74,23 @@ BakeResult bake(const Scene& scene, const BakeOptions& opt, const std::string& i
 
     // W = M R: the compression matrix in float for the GEMM, with the band filter folded into
     // its rows (filtering the weights equals filtering M's rows: diag(h) (M R) = (diag(h) M) R).
-    Eigen::MatrixXd Md = opt.leastSquares ? leastSquaresMatrix(opt.grid, opt.order)
-                                          : compressionMatrixCached(opt.grid, opt.order, opt.cacheDir);
+    // The weighted fit solves per sample; the others are one matrix for every sample.
+    const bool weighted = opt.fit == Fit::Weighted;
+    std::unique_ptr<WeightedFitter> fitter;
+    Eigen::MatrixXf Mt;
     std::vector<double> h = shBandFilter(opt.order, opt.filterWidth);
     std::vector<int> band = evenBands(opt.order);
-    for (int k = 0; k < K; ++k) Md.row(k) *= h[band[k]];
-    // Stored transposed: the GEMM then yields W^T, whose column k (coefficient k of every
-    // sample in the batch, x y z len interleaved) is one contiguous copy into the weights.
-    const Eigen::MatrixXf Mt = Md.transpose().cast<float>();
+    if (weighted) {
+        fitter = std::make_unique<WeightedFitter>(opt.grid, opt.order, opt.weighting);
+    } else {
+        Eigen::MatrixXd Md = opt.fit == Fit::LeastSquares
+                                 ? leastSquaresMatrix(opt.grid, opt.order)
+                                 : compressionMatrixCached(opt.grid, opt.order, opt.cacheDir);
+        for (int k = 0; k < K; ++k) Md.row(k) *= h[band[k]];
+        // Stored transposed: the GEMM then yields W^T, whose column k (coefficient k of every
+        // sample in the batch, x y z len interleaved) is one contiguous copy into the weights.
+        Mt = Md.transpose().cast<float>();
+    }
 
     std::vector<glm::vec3> dirs(J);
     for (int j = 0; j < J; ++j) dirs[j] = glm::vec3(opt.grid.direction(j));
@@ -79,7 +107,9 @@ BakeResult bake(const Scene& scene, const BakeOptions& opt, const std::string& i
 
     tbb::parallel_for(tbb::blocked_range<size_t>(0, batches, 1), [&](const tbb::blocked_range<size_t>& range) {
         enableFlushToZero();
-        Eigen::MatrixXf R(J, 4 * kBatch), Wt(4 * kBatch, K);
+        Eigen::MatrixXf R(J, 4 * kBatch), Wt(4 * kBatch, K), W(K, 4);
+        std::vector<PathResult> paths(weighted ? size_t(J) * kBatch : 0);
+        std::vector<float> confidence(weighted ? J : 0);
         for (size_t b = range.begin(); b != range.end(); ++b) {
             if (opt.cancel && opt.cancel->load()) return;
             const size_t first = b * kBatch, count = std::min<size_t>(kBatch, n - first);
@@ -92,6 +122,7 @@ BakeResult bake(const Scene& scene, const BakeOptions& opt, const std::string& i
                 for (int j = 0; j < J; ++j) {
                     const glm::vec3 omega = frame.fromLocal(dirs[j]);
                     PathResult p = tracer.trace(L.position[i], L.normal[i], omega, L.part[i]);
+                    if (weighted) paths[s * J + j] = p;
                     R(j, 4 * s + 0) = p.exit.x;
                     R(j, 4 * s + 1) = p.exit.y;
                     R(j, 4 * s + 2) = p.exit.z;
@@ -106,7 +137,17 @@ BakeResult bake(const Scene& scene, const BakeOptions& opt, const std::string& i
                 }
             }
             auto tGemm = Clock::now();
-            Wt.noalias() = R.transpose() * Mt;  // the projection W = M R: one GEMM per batch
+            if (weighted) {
+                // One solve per sample, the band filter applied to its weights.
+                for (size_t s = 0; s < count; ++s) {
+                    fitter->confidence(&paths[s * J], confidence.data());
+                    fitter->fit(R.middleCols(4 * s, 4), confidence.data(), W);
+                    for (int k = 0; k < K; ++k) W.row(k) *= float(h[band[k]]);
+                    Wt.middleRows(4 * s, 4) = W.transpose();
+                }
+            } else {
+                Wt.noalias() = R.transpose() * Mt;  // the projection W = M R: one GEMM per batch
+            }
             for (int k = 0; k < K; ++k)
                 std::copy_n(Wt.col(k).data(), 4 * count, &data.weights[(size_t(k) * n + first) * 4]);
             auto tEnd = Clock::now();
@@ -152,7 +193,8 @@ BakeResult bake(const Scene& scene, const BakeOptions& opt, const std::string& i
         {"input", ec ? inputPath : abs.string()},
         {"grid", {opt.grid.nTheta, opt.grid.nPhi}},
         {"filterWidth", opt.filterWidth},
-        {"fit", opt.leastSquares ? "least-squares" : "projection"},
+        {"fit", ToString(opt.fit)},
+        {"fitWeighting", weighted ? opt.weighting.ToString() : ""},
         {"branch", opt.trace.branch == Branch::Fresnel ? "fresnel" : "transmit"},
         {"maxBounces", opt.trace.maxBounces},
         {"media", media},

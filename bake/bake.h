@@ -7,6 +7,7 @@
 #include <functional>
 #include <string>
 
+#include "bake/fit.h"
 #include "bake/tracer.h"
 #include "common/bakefile.h"
 #include "common/direction_grid.h"
@@ -20,6 +21,15 @@ struct BakeProgress {
     double seconds = 0.0;
 };
 
+// How each sample's grid of traced paths becomes SH weights (docs/bake.md "Fits").
+enum class Fit {
+    Projection,    // W = M R through the compression matrix (paper eq. 10)
+    LeastSquares,  // solid-angle-weighted least squares on the grid samples
+    Weighted,      // least squares weighted by each path's confidence (bake/fit.h)
+};
+const char* ToString(Fit fit);   // "projection" | "lsq" | "weighted"
+Fit parseFit(const std::string& text);  // throws InputError
+
 struct BakeOptions {
     int order = 8;           // SH order L
     int rate = 0;            // grid steps per triangle edge; 0: from `samples`
@@ -27,7 +37,8 @@ struct BakeOptions {
     DirectionGrid grid;      // 32 x 64 = 2048 directions, the paper's count
     TraceOptions trace;
     double filterWidth = 0.0;  // semi-Gaussian width in bands; <= 0: none
-    bool leastSquares = false; // fit by weighted least squares instead of projecting through M
+    Fit fit = Fit::Projection;
+    FitWeighting weighting;    // for Fit::Weighted
     Precision precision = Precision::F32;
     int threads = 0;         // 0: all cores
     std::string cacheDir;    // compression matrix cache; empty: none

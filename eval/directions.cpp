@@ -12,9 +12,19 @@
 #include "bake/tracer.h"
 #include "common/decompress.h"
 #include "common/error.h"
+#include "common/direction_grid.h"
 #include "common/frame.h"
 
 namespace shrefract {
+
+namespace {
+// Angle in degrees between the unnormalized a and the unit b (180 if a vanishes).
+double angleDegrees(glm::vec3 a, glm::vec3 b) {
+    const float len = glm::length(a);
+    const double c = len > 0 ? glm::dot(a / len, b) : -1.0;
+    return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / M_PI;
+}
+}  // namespace
 
 Scene sceneOfBake(const BakeData& bake, const std::string& bakePath, const std::string& overridePath) {
     const nlohmann::json& m = bake.manifest;
@@ -74,42 +84,69 @@ nlohmann::json evaluateDirections(const BakeData& bake, const Scene& scene, size
         float z = zMin + (zMax - zMin) * U(rng), phi = 6.28318530718f * U(rng), sxy = std::sqrt(std::max(0.0f, 1 - z * z));
         p.omegaLocal = glm::vec3(sxy * std::cos(phi), sxy * std::sin(phi), z);
     }
-    std::vector<double> angle(pairs), lenErr(pairs);
+    // The data ceiling: the raw grid of traced exits at the same sample, interpolated by the B_j
+    // of the compression (bilinear in theta, phi) at the same omega. What any representation
+    // fitted to this grid could reach (docs/evaluation.md).
+    DirectionGrid grid;
+    const bool haveGrid = m.contains("grid") && m["grid"].is_array() && m["grid"].size() == 2;
+    if (haveGrid) grid.nTheta = m["grid"][0].get<int>(), grid.nPhi = m["grid"][1].get<int>();
+    std::vector<double> angle(pairs), lenErr(pairs), ceilAngle(pairs), ceilLen(pairs);
     std::vector<uint32_t> flags(pairs);
     tbb::parallel_for(size_t(0), pairs, [&](size_t k) {
         enableFlushToZero();
         const Pair& p = draws[k];
         const Frame f = Frame::fromNormal(L.normal[p.sample]);
-        PathResult truth = tracer.trace(L.position[p.sample], L.normal[p.sample], f.fromLocal(p.omegaLocal),
-                                        L.part[p.sample]);
+        const glm::vec3 P = L.position[p.sample], N = L.normal[p.sample];
+        const uint32_t part = L.part[p.sample];
+        PathResult truth = tracer.trace(P, N, f.fromLocal(p.omegaLocal), part);
         const int o = sampleOrder ? (*sampleOrder)[p.sample] : order;
         glm::vec4 d = decompressSample(bake, static_cast<int>(p.sample), p.omegaLocal, o);
-        glm::vec3 e(d);
-        float len = glm::length(e);
-        double cosA = len > 0 ? glm::dot(e / len, truth.exit) : -1.0;
-        angle[k] = std::acos(std::clamp(cosA, -1.0, 1.0)) * 180.0 / M_PI;
+        angle[k] = angleDegrees(glm::vec3(d), truth.exit);
         lenErr[k] = std::abs(double(d.w) - truth.length);
         flags[k] = truth.flags;
-    });
-    auto subset = [&](uint32_t mask, bool none) {
-        std::vector<double> a, l;
-        for (size_t k = 0; k < pairs; ++k) {
-            bool in = none ? (flags[k] & (kPathTIR | kPathCapped | kPathReentered)) == 0 : (flags[k] & mask) != 0;
-            if (in) a.push_back(angle[k]), l.push_back(lenErr[k]);
+        if (haveGrid) {
+            int index[4];
+            double weight[4];
+            const int n = grid.interpolate(glm::dvec3(p.omegaLocal), index, weight);
+            glm::vec3 e(0.0f);
+            float len = 0.0f;
+            for (int j = 0; j < n; ++j) {
+                const PathResult g = tracer.trace(P, N, f.fromLocal(glm::vec3(grid.direction(index[j]))), part);
+                e += float(weight[j]) * g.exit;
+                len += float(weight[j]) * g.length;
+            }
+            ceilAngle[k] = angleDegrees(e, truth.exit);
+            ceilLen[k] = std::abs(double(len) - truth.length);
         }
-        return nlohmann::json{{"share", double(a.size()) / std::max<size_t>(1, pairs)},
-                              {"angleDeg", errorStats(a)},
-                              {"lengthError", errorStats(l)}};
+    });
+    // The pairs whose traced path has any of `mask`'s flags (mask 0: none of TIR, capped and
+    // re-entered, the "plain" paths; ~0u: every pair).
+    auto subset = [&](uint32_t mask) {
+        std::vector<double> a, l, ca, cl;
+        for (size_t k = 0; k < pairs; ++k) {
+            const bool in = mask == 0 ? (flags[k] & (kPathTIR | kPathCapped | kPathReentered)) == 0
+                                      : mask == ~0u || (flags[k] & mask) != 0;
+            if (!in) continue;
+            a.push_back(angle[k]), l.push_back(lenErr[k]);
+            ca.push_back(ceilAngle[k]), cl.push_back(ceilLen[k]);
+        }
+        nlohmann::json j{{"share", double(a.size()) / std::max<size_t>(1, pairs)},
+                         {"angleDeg", errorStats(a)},
+                         {"lengthError", errorStats(l)}};
+        if (haveGrid) j["ceiling"] = {{"angleDeg", errorStats(ca)}, {"lengthError", errorStats(cl)}};
+        return j;
     };
+    const nlohmann::json all = subset(~0u);
     return {{"pairs", pairs},
             {"seed", seed},
             {"order", order < 0 ? bake.order : std::min(order, bake.order)},
-            {"angleDeg", errorStats(angle)},
-            {"lengthError", errorStats(lenErr)},
-            {"tir", subset(kPathTIR, false)},
-            {"capped", subset(kPathCapped, false)},
-            {"reentered", subset(kPathReentered, false)},
-            {"plain", subset(0, true)}};
+            {"angleDeg", all["angleDeg"]},
+            {"lengthError", all["lengthError"]},
+            {"all", all},
+            {"tir", subset(kPathTIR)},
+            {"capped", subset(kPathCapped)},
+            {"reentered", subset(kPathReentered)},
+            {"plain", subset(0)}};
 }
 
 std::vector<int> adaptiveOrders(const BakeData& bake, double toleranceDeg) {

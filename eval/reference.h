@@ -20,11 +20,22 @@ struct ReferenceView {
     glm::vec3 eye{0, 0, 3}, target{0, 0, 0}, up{0, 1, 0};
     float fovDegrees = 45.0f;
     int width = 0, height = 0;
+    // Samples per pixel for the colour: 1 traces the pixel centre (as GL rasterizes); N > 1 takes
+    // a stratified jittered pattern of ceil(sqrt N)^2 cells, N of them used (docs/evaluation.md).
+    int spp = 1;
 };
 
 // The unit world direction through the centre of pixel (x, y), row 0 at the top: GL samples
 // pixel centres (x + 0.5, y + 0.5) in window space with y up, and the runtime flips rows.
 glm::vec3 primaryRay(const ReferenceView& view, int x, int y);
+// The direction through the point (px, py) of the image plane in pixel units, (0, 0) the top-left
+// corner of pixel (0, 0): primaryRay(v, x, y) is primaryRay(v, x + 0.5, y + 0.5).
+glm::vec3 primaryRay(const ReferenceView& view, float px, float py);
+
+// Sample s (0 <= s < spp) of pixel (x, y) as an offset in [0, 1)^2 inside the pixel: the cells of
+// an n x n grid (n = ceil(sqrt spp)) in a fixed scrambled order, each jittered by a hash of
+// (x, y, s). Deterministic, so references are reproducible.
+glm::vec2 pixelSample(int x, int y, int s, int spp);
 
 // The bake's path rules as recorded in its manifest (branch, maxBounces).
 TraceOptions traceOptionsOfBake(const BakeData& bake);
@@ -47,7 +58,10 @@ struct ReferenceStats {
     size_t tir = 0, capped = 0, reentered = 0, geometricNormal = 0, backFacing = 0;
 };
 
-// Renders one frame, object at the origin (identity model, as shrefract-render):
+// Renders one frame, object at the origin (identity model, as shrefract-render). With spp > 1
+// the colour is the mean over the pixel's samples (background samples included: anti-aliased
+// silhouettes); the direction buffer and coverage stay those of the pixel centre, so angular
+// error is always measured against the 1-sample truth. Per sample:
 //   primary ray -> first hit (part q, exact mesh) -> n = interpolated shading normal
 //   colour = F * env(reflect) + (1 - F) * env(exit) * exp(-kappa_q * length)
 // with F = FresnelDielectric(n . omega, ior_q), exit and length from tracer.trace(hit, n, omega,

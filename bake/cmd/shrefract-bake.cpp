@@ -47,10 +47,14 @@ int main(int argc, char** argv) {
     app.add_option("--max-bounces", opt.trace.maxBounces, "bounce cap per path")->capture_default_str()->check(CLI::Range(1, 10000));
     app.add_option("--filter", opt.filterWidth, "semi-Gaussian SH low-pass width in bands (0: none)")
         ->capture_default_str()->check(CLI::Range(0.0, 1000.0));
-    std::string fit = "projection";
-    app.add_option("--fit", fit, "projection: W = M R through the compression matrix; lsq: "
-                                 "weighted least squares on the grid samples")
-        ->capture_default_str()->check(CLI::IsMember({"projection", "lsq"}));
+    std::string fit = ToString(opt.fit), weighting = opt.weighting.ToString();
+    app.add_option("--fit", fit, "projection: W = M R through the compression matrix (the paper); lsq: "
+                                 "least squares on the grid samples; weighted: least squares weighted by "
+                                 "each path's confidence (docs/bake.md \"Fits\")")
+        ->capture_default_str()->check(CLI::IsMember({"projection", "lsq", "weighted"}));
+    app.add_option("--fit-weighting", weighting,
+                   "--fit weighted: FLAGGED:DEG:DISAGREEING:TRIMDEG:TRIMMED:PASSES (bake/fit.h)")
+        ->capture_default_str();
     app.add_option("--precision", precision, "weight storage: f32, f16 or u8")->capture_default_str()
         ->check(CLI::IsMember({"f32", "f16", "u8"}));
     app.add_option("--threads", opt.threads, "worker threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
@@ -69,7 +73,8 @@ int main(int argc, char** argv) {
         opt.grid = parseGrid(grid, "--grid");
         opt.trace.branch = branch == "transmit" ? Branch::Transmit : Branch::Fresnel;
         opt.precision = parsePrecision(precision);
-        opt.leastSquares = fit == "lsq";
+        opt.fit = parseFit(fit);
+        opt.weighting = FitWeighting::parse(weighting);
         opt.cacheDir = cache;
         namespace fs = std::filesystem;
         fs::path outDir = fs::absolute(output).parent_path();

@@ -20,21 +20,32 @@ using namespace shrefract;
 namespace {
 
 void printTable(const nlohmann::json& r) {
-    auto row = [](const char* name, const nlohmann::json& c) {
+    const bool ceiling = r["all"].contains("ceiling");
+    auto row = [&](const char* name, const nlohmann::json& c) {
         const auto& a = c["angleDeg"];
         if (a["count"].get<size_t>() == 0) {
             std::printf("  %-11s %6.2f%%  (none)\n", name, 100 * c["share"].get<double>());
             return;
         }
-        std::printf("  %-11s %6.2f%%  %8.3f %8.3f %8.3f %8.3f %8.2f   %8.4f\n", name,
+        std::printf("  %-11s %6.2f%%  %8.3f %8.3f %8.3f %8.3f %8.2f   %8.4f", name,
                     100 * c["share"].get<double>(), a["mean"].get<double>(), a["median"].get<double>(),
                     a["p95"].get<double>(), a["p99"].get<double>(), a["max"].get<double>(),
                     c["lengthError"]["mean"].get<double>());
+        if (ceiling)
+            std::printf("   | %8.3f %8.3f %8.3f   %8.4f", c["ceiling"]["angleDeg"]["mean"].get<double>(),
+                        c["ceiling"]["angleDeg"]["median"].get<double>(),
+                        c["ceiling"]["angleDeg"]["p95"].get<double>(),
+                        c["ceiling"]["lengthError"]["mean"].get<double>());
+        std::printf("\n");
     };
-    std::printf("direction error, degrees (%zu pairs, order %d)\n", r["pairs"].get<size_t>(), r["order"].get<int>());
-    std::printf("  %-11s %7s  %8s %8s %8s %8s %8s   %8s\n", "paths", "share", "mean", "median", "p95", "p99",
-                "max", "len err");
-    row("all", {{"share", 1.0}, {"angleDeg", r["angleDeg"]}, {"lengthError", r["lengthError"]}});
+    std::printf("direction error, degrees (%zu pairs, order %d)%s\n", r["pairs"].get<size_t>(),
+                r["order"].get<int>(),
+                ceiling ? "; right: the data ceiling, the raw grid interpolated bilinearly" : "");
+    std::printf("  %-11s %7s  %8s %8s %8s %8s %8s   %8s", "paths", "share", "mean", "median", "p95",
+                "p99", "max", "len err");
+    if (ceiling) std::printf("   | %8s %8s %8s   %8s", "mean", "median", "p95", "len err");
+    std::printf("\n");
+    row("all", r["all"]);
     row("plain", r["plain"]);
     row("TIR", r["tir"]);
     row("re-entered", r["reentered"]);

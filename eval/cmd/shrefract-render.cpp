@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
     std::string bakePath, envPath, camera, eye, target, size = "1024x1024", backend = "egl";
     std::string out, outExr, dirs, dumpDir, preset = "modern", form = "auto";
     float fov = 45.0f, exposure = 1.0f;
-    int order = -1, frames = 5;
+    int order = -1, frames = 5, spp = 1;
     bool smoothing = false;
     std::string method = "sh", wymanTir = "reflect", scenePath;
     bool latLongLookup = false, noVerify = false;
@@ -73,6 +73,10 @@ int main(int argc, char** argv) {
     app.add_option("--form", form, "SH evaluation in GLSL: auto | polynomial | recurrence")
         ->capture_default_str()->check(CLI::IsMember({"auto", "polynomial", "recurrence"}));
     app.add_option("--frames", frames, "frames timed after a warm-up one")->capture_default_str();
+    app.add_option("--spp", spp,
+                   "raytrace: stratified samples per pixel for the colour (64: the anti-aliased "
+                   "reference); the direction buffer keeps the pixel centre")
+        ->capture_default_str()->check(CLI::Range(1, 4096));
     app.add_flag("--smooth", smoothing, "spatial smoothing through the neighbour lists");
     app.add_option("--exposure", exposure, "exposure before the tone map")->capture_default_str();
     app.add_option("--out", out, "tone-mapped PNG");
@@ -121,6 +125,9 @@ int main(int argc, char** argv) {
             throw std::invalid_argument("--method: expected sh | single | wyman | raytrace, got '" +
                                         method + "'");
         const shrefract::WymanTir tir = shrefract::parseWymanTir(wymanTir);
+        if (spp > 1 && method != "raytrace")
+            throw std::invalid_argument("--spp " + std::to_string(spp) +
+                                        ": only --method raytrace takes several samples per pixel");
 
         // Input first (cheap, and the common failure), then the context.
         shrefract::Bake bake = shrefract::loadBake(bakePath, !noVerify);
@@ -146,6 +153,7 @@ int main(int argc, char** argv) {
             shrefract::ReferenceView view;
             view.eye = cam.eye, view.target = cam.target, view.up = cam.up;
             view.fovDegrees = cam.fovDegrees, view.width = width, view.height = height;
+            view.spp = spp;
             shrefract::ReferenceStats stats;
             shrefract::EvalBuffer b = shrefract::renderReference(*tracer, envImage, view, &stats);
             frame.color.resize(b.pixelCount() * 4);

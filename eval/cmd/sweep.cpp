@@ -284,7 +284,7 @@ int main(int argc, char** argv) {
                 {
                     BakeOptions lo = bo;
                     lo.order = 8;
-                    lo.leastSquares = true;
+                    lo.fit = Fit::LeastSquares;
                     BakeResult lsq = bake(scene, lo, mesh);
                     point("fit", "least-squares", 1, renderSh(makeBake(lsq.data), RefractorOptions{}));
                     point("fit", "projection", 0, points[points.size() - 4].metrics);  // precision f32

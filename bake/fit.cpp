@@ -1,0 +1,125 @@
+#include "bake/fit.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "common/error.h"
+#include "common/sh.h"
+
+namespace shrefract {
+
+FitWeighting FitWeighting::none() {
+    FitWeighting w;
+    w.flagged = 1.0f;
+    w.flags = 0;
+    w.disagreeDeg = 0.0f;
+    w.trimPasses = 0;
+    return w;
+}
+
+FitWeighting FitWeighting::parse(const std::string& text, const std::string& what) {
+    FitWeighting w;
+    std::istringstream in(text);
+    char c[6] = {};
+    const bool ok = bool(in >> w.flagged >> c[0] >> w.disagreeDeg >> c[1] >> w.disagreeing >> c[2] >>
+                         w.trimDeg >> c[3] >> w.trimmed >> c[4] >> w.trimPasses);
+    if (ok && in >> c[5]) in >> w.ridge;
+    const bool colons = std::all_of(c, c + 5, [](char x) { return x == ':'; });
+    if (!ok || !colons || !in.eof() || !(w.flagged > 0 && w.flagged <= 1) ||
+        !(w.disagreeing > 0 && w.disagreeing <= 1) || !(w.trimmed > 0 && w.trimmed <= 1) ||
+        w.trimPasses < 0 || w.trimPasses > 8 || !(w.ridge >= 0) || !(w.disagreeDeg >= 0) || !(w.trimDeg > 0))
+        throw InputError(what + ": expected FLAGGED:DEG:DISAGREEING:TRIMDEG:TRIMMED:PASSES[:RIDGE] "
+                                "with factors in (0, 1], passes 0..8, got '" + text + "'");
+    return w;
+}
+
+std::string FitWeighting::ToString() const {
+    std::ostringstream os;
+    os << flagged << ":" << disagreeDeg << ":" << disagreeing << ":" << trimDeg << ":" << trimmed
+       << ":" << trimPasses;
+    if (ridge > 0) os << ":" << ridge;
+    return os.str();
+}
+
+WeightedFitter::WeightedFitter(const DirectionGrid& grid, int order, const FitWeighting& weighting)
+    : grid_(grid), weighting_(weighting) {
+    const int K = shEvenCount(order), J = grid.count();
+    SHREFRACT_CHECK(J >= K);
+    Y_.resize(J, K);
+    a_.resize(J);
+    const std::vector<ShLM> fs = shEvenFunctions(order);
+    std::vector<double> all(shCount(order));
+    const double dTheta = 0.5 * M_PI / grid.nTheta, dPhi = 2.0 * M_PI / grid.nPhi;
+    for (int j = 0; j < J; ++j) {
+        shEvalAllRecurrence(order, grid.direction(j), all.data());
+        for (int k = 0; k < K; ++k) Y_(j, k) = float(all[shIndex(fs[k].l, fs[k].m)]);
+        const int i = j / grid.nPhi;  // cell solid angle: dPhi (cos theta_lo - cos theta_hi)
+        a_(j) = float(dPhi * (std::cos(i * dTheta) - std::cos((i + 1) * dTheta)));
+    }
+    Gall_ = Y_.transpose() * a_.asDiagonal() * Y_;
+    ridge_.resize(K);
+    for (int k = 0; k < K; ++k) ridge_(k) = weighting.ridge * float(fs[k].l * (fs[k].l + 1));
+}
+
+void WeightedFitter::confidence(const PathResult* paths, float* c) const {
+    const int J = directions();
+    for (int j = 0; j < J; ++j) c[j] = (paths[j].flags & weighting_.flags) ? weighting_.flagged : 1.0f;
+    if (weighting_.disagreeDeg <= 0) return;
+    // Neighbours in theta (same phi) and in phi (same ring, wrapping): both of a pair whose exits
+    // differ by more than the threshold disagree.
+    const float cosMax = std::cos(weighting_.disagreeDeg * float(M_PI) / 180.0f);
+    const float d = weighting_.disagreeing;
+    auto lower = [&](int j) { c[j] = std::min(c[j], d); };
+    const int nT = grid_.nTheta, nP = grid_.nPhi;
+    for (int i = 0; i < nT; ++i)
+        for (int k = 0; k < nP; ++k) {
+            const int j = i * nP + k;
+            const int right = i * nP + (k + 1) % nP, up = (i + 1) * nP + k;
+            if (glm::dot(paths[j].exit, paths[right].exit) < cosMax) lower(j), lower(right);
+            if (i + 1 < nT && glm::dot(paths[j].exit, paths[up].exit) < cosMax) lower(j), lower(up);
+        }
+}
+
+void WeightedFitter::fit(const Eigen::Ref<const Eigen::MatrixXf>& R, const float* c,
+                         Eigen::Ref<Eigen::MatrixXf> W) const {
+    solve(R, c, W);
+    const int J = directions();
+    const float cosTrim = std::cos(weighting_.trimDeg * float(M_PI) / 180.0f);
+    std::vector<float> ct(c, c + J);
+    for (int pass = 0; pass < weighting_.trimPasses; ++pass) {
+        const Eigen::MatrixXf fitted = Y_ * W;  // J x 4
+        bool changed = false;
+        for (int j = 0; j < J; ++j) {
+            const glm::vec3 f(fitted(j, 0), fitted(j, 1), fitted(j, 2)), r(R(j, 0), R(j, 1), R(j, 2));
+            const float lf = glm::length(f), lr = glm::length(r);
+            const bool miss = !(lf > 0 && lr > 0) || glm::dot(f, r) < cosTrim * lf * lr;
+            // Each direction is trimmed once: c_j * trimmed, never trimmed again.
+            if (miss && ct[j] == c[j]) ct[j] = c[j] * weighting_.trimmed, changed = true;
+        }
+        if (!changed) break;
+        solve(R, ct.data(), W);
+    }
+}
+
+void WeightedFitter::solve(const Eigen::Ref<const Eigen::MatrixXf>& R, const float* c,
+                           Eigen::Ref<Eigen::MatrixXf> W) const {
+    const int J = directions(), K = coefficients();
+    SHREFRACT_CHECK(R.rows() == J && R.cols() == 4 && W.rows() == K && W.cols() == 4);
+    // G = Y^T diag(a c) Y = Gall - sum_j a_j (1 - c_j) y_j y_j^T: only the directions with c_j < 1
+    // cost a rank update (about half of them on a busy mesh, few on a simple one).
+    Eigen::MatrixXf G = Gall_;
+    Eigen::MatrixXf down(K, J);
+    int nd = 0;
+    for (int j = 0; j < J; ++j)
+        if (c[j] < 1.0f) down.col(nd++) = std::sqrt(a_(j) * (1.0f - c[j])) * Y_.row(j).transpose();
+    if (nd > 0) G.selfadjointView<Eigen::Lower>().rankUpdate(down.leftCols(nd), -1.0f);
+    G.diagonal() += ridge_;
+    // B = Y^T diag(a c) R.
+    Eigen::VectorXf ac(J);
+    for (int j = 0; j < J; ++j) ac(j) = a_(j) * c[j];
+    W = G.selfadjointView<Eigen::Lower>().llt().solve(Y_.transpose() * (ac.asDiagonal() * R));
+}
+
+}  // namespace shrefract

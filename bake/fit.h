@@ -1,0 +1,72 @@
+// The weighted least-squares fit of `--fit weighted` (docs/bake.md "Fits"): it spends each
+// sample's SH bands on the view directions whose paths the bands can follow.
+//
+// Per sample, with a_j the solid angle of grid cell j and c_j in (0, 1] the confidence of the
+// path traced along direction j,
+//   W = argmin_W  sum_j a_j c_j |sum_k W_k y_k(w_j) - r_j|^2  +  ridge sum_k l_k (l_k + 1) |W_k|^2
+// for the four channels of r (exit x, y, z, length) at once; c_j = 1 everywhere and ridge 0 is
+// the plain least-squares fit (`--fit lsq`). The confidence is the product of what the bake
+// knows about each direction:
+//  - its path's flags: total internal reflection, re-entry or the bounce cap: c_j *= `flagged`;
+//  - its neighbours: where the exit turns by more than `disagreeDeg` to a grid neighbour's, the
+//    mapping changes faster than the grid samples it: c_j is at most `disagreeing`;
+//  - the fit itself (`trimPasses` times): where a fit misses r_j by more than `trimDeg`, the bands
+//    cannot follow that direction: c_j *= `trimmed`, and the sample is fitted again.
+// Fitting the chaotic directions closely rings over the whole hemisphere; down-weighted, the bands
+// follow the learnable part (measured by scripts/fit-study; docs/bake.md "Fits").
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "bake/tracer.h"
+#include "common/direction_grid.h"
+
+namespace shrefract {
+
+struct FitWeighting {
+    float flagged = 0.3f;  // c_j factor of a path with one of `flags`
+    uint32_t flags = kPathTIR | kPathReentered | kPathCapped;
+    float disagreeDeg = 30.0f;  // <= 0: no neighbour test
+    float disagreeing = 0.01f;  // c_j at most this where the exit turns more than disagreeDeg
+    float trimDeg = 20.0f;      // a fitted direction this far off is trimmed...
+    float trimmed = 0.03f;      // ...c_j times this...
+    int trimPasses = 1;         // ...and the sample fitted again, this many times (0: none)
+    float ridge = 0.0f;         // Tikhonov weight on band l: ridge * l (l + 1)
+
+    // No weighting at all: the plain least-squares fit.
+    static FitWeighting none();
+    // "FLAGGED:DEG:DISAGREEING:TRIMDEG:TRIMMED:PASSES[:RIDGE]" (the defaults are
+    // "0.3:30:0.01:20:0.03:1"); throws InputError naming `what` on bad text.
+    static FitWeighting parse(const std::string& text, const std::string& what = "--fit-weighting");
+    std::string ToString() const;
+};
+
+// Fits one sample at a time; build once per (grid, order, weighting), use from many threads.
+class WeightedFitter {
+public:
+    WeightedFitter(const DirectionGrid& grid, int order, const FitWeighting& weighting);
+    int coefficients() const { return int(Y_.cols()); }
+    int directions() const { return int(Y_.rows()); }
+    // c_j of one sample's J paths from their flags and exits (before any trim pass), into c[0..J).
+    void confidence(const PathResult* paths, float* c) const;
+    // W (K x 4, column c = channel) from R (J x 4, column c = channel: exit x, y, z, length at
+    // grid direction j) and the confidences c, trim passes included.
+    void fit(const Eigen::Ref<const Eigen::MatrixXf>& R, const float* c,
+             Eigen::Ref<Eigen::MatrixXf> W) const;
+
+private:
+    void solve(const Eigen::Ref<const Eigen::MatrixXf>& R, const float* c,
+               Eigen::Ref<Eigen::MatrixXf> W) const;
+    DirectionGrid grid_;
+    FitWeighting weighting_;
+    Eigen::MatrixXf Y_;     // J x K: the stored functions at the grid directions
+    Eigen::VectorXf a_;     // J: cell solid angles
+    Eigen::MatrixXf Gall_;  // K x K: Y^T diag(a) Y, every direction at confidence 1
+    Eigen::VectorXf ridge_; // K: ridge * l (l + 1)
+};
+
+}  // namespace shrefract

@@ -88,8 +88,14 @@ CubeMapImage cubeFromLatLong(const LatLongImage& image, int faceSize) {
     return cube;
 }
 
-glm::vec3 sampleCube(const CubeMapImage& cube, glm::vec3 d) {
-    // GL 4.5 spec table 8.19: the major axis picks the face; (sc, tc) / |ma| in [-1, 1].
+namespace {
+
+// GL 4.5 spec table 8.19: the major axis picks the face; (sc, tc) / |ma| in [-1, 1].
+struct FaceCoord {
+    int face;
+    float s, t;  // [-1, 1] on the face
+};
+FaceCoord faceOf(glm::vec3 d) {
     const glm::vec3 a = glm::abs(d);
     int f;
     float sc, tc, ma;
@@ -100,14 +106,31 @@ glm::vec3 sampleCube(const CubeMapImage& cube, glm::vec3 d) {
     } else {
         f = d.z >= 0 ? 4 : 5, ma = a.z, sc = d.z >= 0 ? d.x : -d.x, tc = -d.y;
     }
+    return {f, sc / ma, tc / ma};
+}
+
+}  // namespace
+
+glm::vec3 sampleCube(const CubeMapImage& cube, glm::vec3 d) {
+    const FaceCoord c = faceOf(d);
     const int n = cube.faceSize;
-    const float x = (sc / ma + 1.0f) * 0.5f * n - 0.5f, y = (tc / ma + 1.0f) * 0.5f * n - 0.5f;
+    const float x = (c.s + 1.0f) * 0.5f * n - 0.5f, y = (c.t + 1.0f) * 0.5f * n - 0.5f;
     const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
     const float fx = x - x0, fy = y - y0;
-    const std::vector<float>& face = cube.faces[f];
+    // A tap inside the face reads its texel; one past an edge reads, like GL's seamless cube
+    // filtering, the neighbour face: the texel nearest to where the direction through the tap's
+    // (extended) centre meets the cube.
     auto at = [&](int xi, int yi) {
+        int f = c.face;
+        if (xi < 0 || yi < 0 || xi >= n || yi >= n) {
+            const FaceCoord o = faceOf(cubeFaceDirection(f, 2.0f * (xi + 0.5f) / n - 1.0f,
+                                                         2.0f * (yi + 0.5f) / n - 1.0f));
+            f = o.face;
+            xi = static_cast<int>(std::floor((o.s + 1.0f) * 0.5f * n));
+            yi = static_cast<int>(std::floor((o.t + 1.0f) * 0.5f * n));
+        }
         xi = std::clamp(xi, 0, n - 1), yi = std::clamp(yi, 0, n - 1);
-        const float* p = &face[(static_cast<size_t>(yi) * n + xi) * 3];
+        const float* p = &cube.faces[f][(static_cast<size_t>(yi) * n + xi) * 3];
         return glm::vec3(p[0], p[1], p[2]);
     };
     return (1 - fx) * (1 - fy) * at(x0, y0) + fx * (1 - fy) * at(x0 + 1, y0) +

@@ -34,8 +34,8 @@ struct CubeMapImage {
 CubeMapImage cubeFromLatLong(const LatLongImage& image, int faceSize = 0);
 // The direction through (s, t) in [-1, 1]^2 of face f, OpenGL's face orientation table.
 glm::vec3 cubeFaceDirection(int face, float s, float t);
-// GL_LINEAR lookup as the GL spec selects faces (major axis) and coordinates. Within half a
-// texel of a face edge GL's seamless filtering blends the neighbour face; this clamps instead.
+// GL_LINEAR lookup with seamless cube filtering, as the GL spec selects faces (major axis) and
+// coordinates: a bilinear tap past a face edge reads the neighbour face's nearest texel.
 glm::vec3 sampleCube(const CubeMapImage& cube, glm::vec3 d);
 
 }  // namespace shrefract

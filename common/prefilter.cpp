@@ -1,9 +1,10 @@
 #include "common/prefilter.h"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <thread>
+#include <vector>
 
 #include "common/error.h"
 #include "common/frame.h"
@@ -12,7 +13,22 @@ namespace shrefract {
 
 namespace {
 constexpr float kPi = 3.14159265358979f;
+
+// body(i) for i in [0, n) on all cores. std::thread rather than TBB: the runtime library carries
+// this file, and its link interface stays free of TBB (docs/runtime.md "Install").
+template <typename Body>
+void parallelFor(int n, const Body& body) {
+    const int threads = std::max(1, std::min<int>(n, int(std::thread::hardware_concurrency())));
+    std::atomic<int> next{0};
+    auto work = [&] {
+        for (int i = next++; i < n; i = next++) body(i);
+    };
+    std::vector<std::thread> pool;
+    for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+    work();
+    for (std::thread& t : pool) t.join();
 }
+}  // namespace
 
 float PrefilteredCube::sigma(int level) const {
     if (level <= 0 || levels.empty()) return 0.0f;
@@ -43,7 +59,7 @@ PrefilteredCube prefilterCube(const CubeMapImage& base, int samples) {
         }
         CubeMapImage& d = out.levels.back();
         for (int f = 0; f < 6; ++f) d.faces[f].assign(size_t(n) * n * 3, 0.0f);
-        tbb::parallel_for(0, 6 * n, [&](int row) {
+        parallelFor(6 * n, [&](int row) {
             const int f = row / n, y = row % n;
             for (int x = 0; x < n; ++x) {
                 const glm::vec3 dir = glm::normalize(

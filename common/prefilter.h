@@ -24,7 +24,7 @@ struct PrefilteredCube {
 // Level l >= 1 from level l - 1 by a vMF lobe of width sqrt(sigma_l^2 - sigma_{l-1}^2) (widths
 // add in quadrature under convolution, exactly for small lobes), sampled at `samples`
 // stratified points of the lobe (filtered importance sampling: the source level's own blur is
-// about half the lobe). Parallel (TBB). A constant image stays constant; energy is kept.
+// about half the lobe). Parallel (std::thread). A constant image stays constant; energy is kept.
 PrefilteredCube prefilterCube(const CubeMapImage& base, int samples = 128);
 
 // The fractional mip level whose lobe is sigma wide: sigma / sigma_1 below sigma_1 (a blend of

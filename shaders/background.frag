@@ -1,7 +1,6 @@
 #version 330 core
 // The environment behind everything, looked up along each pixel's view ray.
 #include "shading.glsl"
-uniform samplerCube uEnvironment;
 uniform mat4 uInverseViewProjection;  // rotation-only view
 uniform vec2 uViewport;
 uniform vec2 uViewportOrigin;
@@ -13,7 +12,7 @@ layout(location = 1) out vec4 oDirection;
 void main() {
     vec2 ndc = (gl_FragCoord.xy - uViewportOrigin) / uViewport * 2.0 - 1.0;
     vec4 d = uInverseViewProjection * vec4(ndc, 1.0, 1.0);
-    vec3 c = texture(uEnvironment, normalize(d.xyz / d.w)).rgb;
+    vec3 c = environment(normalize(d.xyz / d.w), 0.0);
     oColor = vec4(uToneMap ? toneMap(c, uExposure) : c, 1.0);
     oDirection = vec4(0.0);
 }

@@ -5,7 +5,6 @@
 // absorption and the environment lookup are the SH shading's (shading.glsl), so the methods
 // differ only in the exit direction and length.
 #include "shading.glsl"
-uniform samplerCube uEnvironment;
 uniform sampler2D uBack;       // Wyman pass 1 (nearest), viewport-sized
 uniform mat4 uView;
 uniform mat4 uViewProjection;
@@ -69,7 +68,7 @@ void main() {
         // P2 projected outside the back-face buffer: no second normal; T1 continues.
     }
     exitDir = normalize(exitDir);
-    vec3 c = shadeGlass(uEnvironment, exitDir, len, N1, V, uEta, uKappa);
+    vec3 c = shadeGlass(exitDir, 0.0, len, N1, V, uEta, uKappa, 0.0);  // the published methods: sharp lookups
     oColor = vec4(uToneMap ? toneMap(c, uExposure) : c, 1.0);
     oDirection = vec4(exitDir, 1.0);
 }

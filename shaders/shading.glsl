@@ -1,6 +1,42 @@
 // The shading every method shares (included by shade.frag, baseline.frag, background.frag), so
-// SH, the baselines and the background differ only in the exit direction and length they pass
-// in. Twins: common/optics.h (Fresnel), common/tonemap.h (tone map).
+// SH, the baselines and the background differ only in the exit direction, its spread and the
+// length they pass in. Twins: common/optics.h (Fresnel), common/tonemap.h (tone map),
+// common/prefilter.h (lobe widths and levels).
+
+// The environment: a cube map whose mip level l >= 1 is the sharp level 0 convolved with a vMF
+// lobe sigma_l = (pi / faceSize) 2^(l - 1) radians wide (common/prefilter.h, uploaded by
+// runtime/src/environment.cpp; every program using this library sets these three).
+uniform samplerCube uEnvironment;
+uniform float uEnvironmentFaceSize;  // of level 0
+uniform float uEnvironmentLevels;    // mip levels present (1: sharp only)
+
+// common/prefilter.h lodForSigma: the level whose lobe is sigma wide.
+float environmentLod(float sigma) {
+    float s1 = 3.14159265 / uEnvironmentFaceSize;
+    float lod = sigma <= s1 ? sigma / s1 : 1.0 + log2(sigma / s1);
+    return clamp(lod, 0.0, uEnvironmentLevels - 1.0);
+}
+
+// The environment along d, averaged over a lobe of width sigma (0: the sharp lookup).
+vec3 environment(vec3 d, float sigma) {
+    return textureLod(uEnvironment, d, environmentLod(sigma)).rgb;
+}
+
+// common/prefilter.h spreadSigma: the width (radians) of the vMF lobe whose mean resultant
+// length is r (the length of the SH reconstruction of a unit exit direction), times scale.
+float spreadSigma(float r, float scale) {
+    r = clamp(r, 1e-4, 1.0);
+    if (r >= 1.0) return 0.0;
+    float kappa = r * (3.0 - r * r) / (1.0 - r * r);
+    return scale * inversesqrt(kappa);
+}
+
+// How far (radians) the unit direction d turns across one pixel, times scale: the part of the
+// pixel's footprint a single lookup would alias.
+float footprintSigma(vec3 d, float scale) {
+    return scale * max(length(dFdx(d)), length(dFdy(d)));
+}
+
 // common/optics.h FresnelDielectric: unpolarized, eta = n_t / n_i, 1 on TIR.
 float fresnelDielectric(float cosI, float eta) {
     cosI = clamp(cosI, 0.0, 1.0);
@@ -20,10 +56,12 @@ vec3 toneMap(vec3 c, float exposure) {
 }
 
 // Front-surface Fresnel reflection plus the transmitted environment along the exit direction,
-// attenuated by exp(-kappa * length). n: unit normal, v: unit direction toward the viewer.
-vec3 shadeGlass(samplerCube env, vec3 exitDir, float len, vec3 n, vec3 v, float eta, vec3 kappa) {
+// attenuated by exp(-kappa * length). n: unit normal, v: unit direction toward the viewer;
+// exitSigma, reflectSigma: lobe widths of the two lookups (0: sharp).
+vec3 shadeGlass(vec3 exitDir, float exitSigma, float len, vec3 n, vec3 v, float eta, vec3 kappa,
+                float reflectSigma) {
     float F = fresnelDielectric(dot(n, v), eta);
-    vec3 transmitted = texture(env, exitDir).rgb * exp(-kappa * max(len, 0.0));
-    vec3 reflected = texture(env, reflect(-v, n)).rgb;
+    vec3 transmitted = environment(exitDir, exitSigma) * exp(-kappa * max(len, 0.0));
+    vec3 reflected = environment(reflect(-v, n), reflectSigma);
     return F * reflected + (1.0 - F) * transmitted;
 }

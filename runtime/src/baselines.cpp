@@ -11,6 +11,7 @@
 
 #include "common/bakefile.h"
 #include "gl.h"
+#include "environment_gl.h"
 #include "shaders.h"
 
 namespace shrefract {
@@ -96,7 +97,6 @@ std::unique_ptr<Baseline> Baseline::create(const Bake& bake, const std::vector<f
     m->backProgram = buildProgram(shaders::source("baseline.vert"), shaders::source("back_face.frag"), "Wyman back faces");
     m->shadeProgram = buildProgram(shaders::source("baseline.vert"), shaders::source("baseline.frag"), "baseline shading");
     glUseProgram(m->shadeProgram);
-    glUniform1i(glGetUniformLocation(m->shadeProgram, "uEnvironment"), 0);
     glUniform1i(glGetUniformLocation(m->shadeProgram, "uBack"), 1);
     glUseProgram(0);
 
@@ -194,7 +194,6 @@ void Baseline::draw(const glm::mat4& view, const glm::mat4& projection, const gl
     }
 
     m.begin(1);
-    glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
     GLuint p = m.shadeProgram;
     common(p);
     glUniform3f(glGetUniformLocation(p, "uEye"), eye.x, eye.y, eye.z);
@@ -207,8 +206,7 @@ void Baseline::draw(const glm::mat4& view, const glm::mat4& projection, const gl
     glUniform2f(glGetUniformLocation(p, "uViewportOrigin"), float(viewport[0]), float(viewport[1]));
     glUniform1i(glGetUniformLocation(p, "uToneMap"), m.options.toneMap ? 1 : 0);
     glUniform1f(glGetUniformLocation(p, "uExposure"), m.options.exposure);
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_CUBE_MAP, environment.cubeMap());
+    useEnvironment(p, environment, 0);
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, wyman ? m.backTexture : 0);
     glDrawArrays(GL_TRIANGLES, 0, m.vertexCount);

@@ -69,6 +69,7 @@ using Loader = void* (*)(const char* name);
     X(PFNGLUNIFORM1FPROC, glUniform1f)                                     \
     X(PFNGLUNIFORM2FPROC, glUniform2f)                                     \
     X(PFNGLUNIFORM3FPROC, glUniform3f)                                     \
+    X(PFNGLUNIFORM4FVPROC, glUniform4fv)                                   \
     X(PFNGLUNIFORMMATRIX3FVPROC, glUniformMatrix3fv)                       \
     X(PFNGLUNIFORMMATRIX4FVPROC, glUniformMatrix4fv)                       \
     X(PFNGLBINDFRAGDATALOCATIONPROC, glBindFragDataLocation)               \
@@ -83,6 +84,7 @@ using Loader = void* (*)(const char* name);
     X(PFNGLENABLEVERTEXATTRIBARRAYPROC, glEnableVertexAttribArray)         \
     X(PFNGLVERTEXATTRIBPOINTERPROC, glVertexAttribPointer)                 \
     X(PFNGLDRAWARRAYSPROC, glDrawArrays)                                   \
+    X(PFNGLDRAWELEMENTSPROC, glDrawElements)                               \
     X(PFNGLGENQUERIESPROC, glGenQueries)                                   \
     X(PFNGLDELETEQUERIESPROC, glDeleteQueries)                             \
     X(PFNGLBEGINQUERYPROC, glBeginQuery)                                   \

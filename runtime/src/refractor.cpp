@@ -1,6 +1,10 @@
-// The per-frame pipeline (paper §5.3.2, Figure 9), all texture-space passes in the mu layout
-// except the unpack into rho:
-//   local view direction -> D_mu (generated passes, ping-pong) -> [smoothing] -> rho -> shade.
+// The per-frame pipeline (paper §5.3.2, Figure 9; docs/runtime.md), in one of two paths:
+//   rho    (paper): local view -> D_mu (generated passes, ping-pong) -> [smoothing] -> unpack
+//                   into rho with correction texels -> shade (bilinear rho lookup)
+//   direct (today's GPUs): local view -> D_mu -> [smoothing] -> shade the sample grid as a
+//                   refined mesh, D fetched per vertex and interpolated by the rasterizer;
+//                   or, with vertex decompression, one draw: the shading pass's vertex shader
+//                   evaluates the SH at each sample itself.
 #include <algorithm>
 #include <cstring>
 #include <map>
@@ -10,10 +14,12 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "common/bakefile.h"
+#include "common/error.h"
 #include "common/sh.h"
+#include "environment_gl.h"
 #include "gl.h"
-#include "shaders.h"
 #include "shadergen.h"
+#include "shaders.h"
 #include "shrefract/runtime.h"
 
 namespace shrefract {
@@ -66,7 +72,13 @@ void bindTexture(int unit, GLenum target, GLuint texture) {
     glBindTexture(target, texture);
 }
 
+void setInt(GLuint p, const char* name, int v) { glUniform1i(glGetUniformLocation(p, name), v); }
+void setFloat(GLuint p, const char* name, float v) { glUniform1f(glGetUniformLocation(p, name), v); }
+
 enum Stage { kView, kDecompress, kSmooth, kUnpack, kShade, kStages };
+
+// The weights as they go to the GPU: at the precision they were stored (docs/runtime.md).
+enum class WeightFormat { Float32, Float16, Unorm8 };
 
 }  // namespace
 
@@ -77,25 +89,35 @@ struct Refractor::Impl {
     int order = 0, maxOrder = 0;  // in use; uploaded
     GpuMemory memory;
     bool smoothing = false, correction = true;
+    bool direct = false, spread = true;
+    // Direct path: the SH may be evaluated in the shading's vertex shader (one pass, chosen or
+    // "auto"); they are, unless smoothing (which needs D_mu in texture space) is on.
+    bool vertexShAllowed = false, vertexShRequired = false;
+    bool vertexMode() const { return vertexShAllowed && !smoothing; }
     int muW = 0, muH = 0, rhoW = 0, rhoH = 0, listWidth = 1;
     ShaderLimits limits;
     ShForm form = ShForm::Auto;
+    WeightFormat weightFormat = WeightFormat::Float32;
+    std::vector<float> u8Scale, u8Offset;  // per coefficient k, 4 each: code / 255 * scale + offset
     struct Compiled {
         DecompressionShaders shaders;
-        std::vector<GLuint> programs;
+        std::vector<GLuint> programs;  // texture-space passes
+        GLuint shadeVertexSh = 0;      // direct path, vertex decompression: the shading program
     };
     std::map<int, Compiled> compiled;  // by order, built on first use
     GLuint positionTex = 0, normalTex = 0, weightArray = 0, rhoIndexTex = 0;
     std::vector<GLuint> weightTex;  // one per coefficient (2006 preset)
     GLuint rangeTex = 0, nbrIndexTex = 0, nbrWeightTex = 0;
     Target localView, sum[2], smoothed, rho;
-    GLuint viewProgram = 0, smoothProgram = 0, unpackProgram = 0, shadeProgram = 0;
-    GLuint emptyVao = 0, meshVao = 0, meshVbo = 0;
-    int vertexCount = 0;
+    GLuint viewProgram = 0, smoothProgram = 0, unpackProgram = 0;
+    GLuint shadeRhoProgram = 0, shadeDirectProgram = 0;
+    GLuint emptyVao = 0, rhoVao = 0, rhoVbo = 0, directVao = 0, directIbo = 0;
+    int rhoVertexCount = 0, directIndexCount = 0;
     GLuint queries[kStages] = {};
     Timings timings;
-    GLuint lastD = 0;  // texture holding the D_mu fed to unpack
-    GLuint lastDFbo = 0;
+    GLuint lastD = 0;            // texture holding the D_mu fed to unpack or to the direct shading
+    bool rhoReady = false;       // the rho target holds the map for the last update()
+    glm::vec3 lastEye{0, 0, 3};  // object space, of the last update()
 
     void use() const { ensureLoaded(loader); }
     const Compiled& compiledFor(int L);
@@ -112,13 +134,38 @@ struct Refractor::Impl {
         glGetQueryObjectui64v(queries[s], GL_QUERY_RESULT, &ns);
         *ms = ns * 1e-6;
     }
+    void bindWeights(const DecompressionPass& pass, int firstUnit);
+    void setWeightUniforms(GLuint program, int K);
+    // The texture-space stages: local view, decompression passes, smoothing (into lastD).
+    void decompressInTextureSpace(bool timed);
+    void ensureRhoResources();
+    void buildRhoMesh();
+    GLuint directTextureProgram();
+    void unpackRho(bool timed);
 };
+
+// Binds the weight samplers of `pass` from texture unit `firstUnit` on (the pass's own order of
+// samplers; local view and partial sum are bound by the caller).
+void Refractor::Impl::bindWeights(const DecompressionPass& pass, int firstUnit) {
+    int unit = firstUnit;
+    for (const SamplerBinding& s : pass.samplers) {
+        if (s.kind == SamplerBinding::Weight) bindTexture(unit++, GL_TEXTURE_2D, weightTex[s.coefficient]);
+        if (s.kind == SamplerBinding::WeightArray) bindTexture(unit++, GL_TEXTURE_2D_ARRAY, weightArray);
+    }
+}
+
+void Refractor::Impl::setWeightUniforms(GLuint program, int K) {
+    if (weightFormat != WeightFormat::Unorm8) return;
+    glUniform4fv(glGetUniformLocation(program, "uWeightScale"), K, u8Scale.data());
+    glUniform4fv(glGetUniformLocation(program, "uWeightOffset"), K, u8Offset.data());
+}
 
 const Refractor::Impl::Compiled& Refractor::Impl::compiledFor(int L) {
     auto it = compiled.find(L);
     if (it != compiled.end()) return it->second;
     Compiled c;
     c.shaders = generateDecompression(L, limits, form);
+    const int K = shEvenCount(L);
     for (size_t i = 0; i < c.shaders.passes.size(); ++i) {
         const DecompressionPass& pass = c.shaders.passes[i];
         GLuint p = buildProgram(c.shaders.vertex, pass.fragment,
@@ -127,8 +174,33 @@ const Refractor::Impl::Compiled& Refractor::Impl::compiledFor(int L) {
         glUseProgram(p);
         for (size_t u = 0; u < pass.samplers.size(); ++u)
             glUniform1i(glGetUniformLocation(p, pass.samplers[u].name.c_str()), static_cast<int>(u));
+        setWeightUniforms(p, K);
         c.programs.push_back(p);
     }
+    if (vertexShAllowed) {
+        // The one pass's generated shPass() inside the direct shading's vertex shader.
+        SHREFRACT_CHECK(c.shaders.passes.size() == 1);
+        const DecompressionPass& pass = c.shaders.passes[0];
+        const std::string vs = shaders::withVersion(
+            shaders::fill(shaders::source("shade_direct.vert"), "#pragma shrefract_generated",
+                          pass.generated),
+            limits.version, "#define SHREFRACT_VERTEX_SH");
+        const std::string fs = shaders::withVersion(shaders::source("shade.frag"), limits.version,
+                                                    "#define SHREFRACT_DIRECT");
+        GLuint p = buildProgram(vs, fs, "direct shading with vertex decompression (" + c.shaders.summary() + ")");
+        glUseProgram(p);
+        setInt(p, "uPosition", 2);
+        setInt(p, "uNormal", 3);
+        setInt(p, "uMuWidth", muW);
+        // Units 0 and 1 are the environment and (unused here) D; weights from unit 4 on.
+        int unit = 4;
+        for (const SamplerBinding& s : pass.samplers)
+            if (s.kind == SamplerBinding::Weight || s.kind == SamplerBinding::WeightArray)
+                setInt(p, s.name.c_str(), unit++);
+        setWeightUniforms(p, K);
+        c.shadeVertexSh = p;
+    }
+    glUseProgram(0);
     return compiled.emplace(L, std::move(c)).first->second;
 }
 
@@ -166,26 +238,63 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
     glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &units);
     m->limits = shaderPreset(options.preset, units);
     m->form = parseShForm(options.form);
+    if (options.shading != "spread" && options.shading != "sharp")
+        throw std::invalid_argument("shrefract: shading \"" + options.shading + "\" (spread | sharp)");
+    m->spread = options.shading == "spread";
 
-    // Samples (P, N) and weights, mu layout.
+    // Which path, and where the SH are evaluated on the direct one.
+    if (options.path == "auto")
+        m->direct = options.preset != "2006";
+    else if (options.path == "direct" || options.path == "rho")
+        m->direct = options.path == "direct";
+    else
+        throw std::invalid_argument("shrefract: path \"" + options.path + "\" (direct | rho | auto)");
+    const std::string& dec = options.decompression;
+    if (dec != "auto" && dec != "vertex" && dec != "texture")
+        throw std::invalid_argument("shrefract: decompression \"" + dec + "\" (vertex | texture | auto)");
+    if (dec == "vertex" && (!m->direct || options.smoothing))
+        throw std::invalid_argument(
+            "shrefract: vertex decompression needs the direct path and no smoothing");
+
+    // Weights at their stored precision: u8 codes as RGBA8 UNORM (dequantized in the shader),
+    // f16 as RGBA16F, f32 as RGBA32F (RGBA16F when the app asks for half).
+    m->weightFormat = d.precision == Precision::U8    ? WeightFormat::Unorm8
+                      : d.precision == Precision::F16 ? WeightFormat::Float16
+                      : options.halfWeights           ? WeightFormat::Float16
+                                                      : WeightFormat::Float32;
+    m->limits.unormWeights = m->weightFormat == WeightFormat::Unorm8;
+    const int K = shEvenCount(m->maxOrder);
+    const size_t muTexels = static_cast<size_t>(m->muW) * m->muH;
+    if (m->limits.unormWeights) {
+        m->u8Scale.resize(size_t(K) * 4);
+        m->u8Offset.resize(size_t(K) * 4);
+        for (size_t i = 0; i < m->u8Scale.size(); ++i) {
+            m->u8Scale[i] = d.u8Scale[i] * 255.0f;  // the texel is code / 255
+            m->u8Offset[i] = d.u8Offset[i];
+        }
+    }
+    // A single decompression pass (the modern preset) can run in the shading's vertex shader.
+    const bool onePass = generateDecompression(m->order, m->limits, m->form).passes.size() == 1;
+    m->vertexShAllowed = m->direct && onePass && (dec == "vertex" || dec == "auto");
+    m->vertexShRequired = dec == "vertex";
+    if (dec == "vertex" && !onePass)
+        throw std::invalid_argument("shrefract: vertex decompression needs a one-pass preset");
+
+    // Samples (P, N), mu layout: the view pass reads them, and so does the direct path's
+    // vertex shader (gl_VertexID = sample).
     m->positionTex = makeTexture2D(GL_RGB32F, m->muW, m->muH, GL_RGB, GL_FLOAT,
                                    muImage3(L.position, m->muW, m->muH).data(), GL_NEAREST);
     m->normalTex = makeTexture2D(GL_RGB32F, m->muW, m->muH, GL_RGB, GL_FLOAT,
                                  muImage3(L.normal, m->muW, m->muH).data(), GL_NEAREST);
+    m->memory.samples = 2 * muTexels * 12;  // RGB32F
+
     // Only bands 0..maxOrder go to the GPU: the weights are coefficient-major, so those are the
     // first shEvenCount(maxOrder) layers.
-    const int K = shEvenCount(m->maxOrder);
-    const size_t layer = static_cast<size_t>(m->muW) * m->muH * 4;
-    const size_t muTexels = static_cast<size_t>(m->muW) * m->muH;
-    // Weights stored at half or 8 bits in the file go to the GPU as RGBA16F: half the memory of
-    // RGBA32F, and no precision the file had is lost (u8 codes dequantize to within half's 11
-    // bits). Float32 bakes stay RGBA32F.
-    const bool half = d.precision != Precision::F32;
-    const GLenum weightFormat = half ? GL_RGBA16F : GL_RGBA32F;
-    m->memory.weights = K * muTexels * (half ? 8 : 16);
-    m->memory.samples = 2 * muTexels * 12;  // P, N: RGB32F
-    m->memory.rho = static_cast<size_t>(m->rhoW) * m->rhoH * 16;  // RGBA32UI
-    std::vector<float> padded(layer, 0.0f);
+    GLenum internal = GL_RGBA32F, type = GL_FLOAT;
+    size_t texelBytes = 16;
+    if (m->weightFormat == WeightFormat::Float16) internal = GL_RGBA16F, texelBytes = 8;
+    if (m->weightFormat == WeightFormat::Unorm8) internal = GL_RGBA8, type = GL_UNSIGNED_BYTE, texelBytes = 4;
+    m->memory.weights = K * muTexels * texelBytes;
     if (m->limits.weightArray) {
         // GL 3.3 guarantees 256 layers (order 20 needs 231); llvmpipe allows 2048.
         GLint maxLayers = 256;
@@ -196,29 +305,34 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
                                      std::to_string(maxLayers) + " (set maxOrder lower)");
         glGenTextures(1, &m->weightArray);
         glBindTexture(GL_TEXTURE_2D_ARRAY, m->weightArray);
-        glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, weightFormat, m->muW, m->muH, K, 0, GL_RGBA, GL_FLOAT,
-                     nullptr);
+        glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, internal, m->muW, m->muH, K, 0, GL_RGBA, type, nullptr);
         glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
         glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     }
+    std::vector<float> padded(muTexels * 4, 0.0f);
+    std::vector<uint8_t> codes(muTexels * 4, 0);
     for (int k = 0; k < K; ++k) {
-        std::memcpy(padded.data(), &d.weights[static_cast<size_t>(k) * n * 4],
-                    static_cast<size_t>(n) * 4 * sizeof(float));
-        if (m->limits.weightArray) {
-            glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, k, m->muW, m->muH, 1, GL_RGBA, GL_FLOAT,
-                            padded.data());
+        const float* w = &d.weights[static_cast<size_t>(k) * n * 4];
+        const void* data = padded.data();
+        if (m->weightFormat == WeightFormat::Unorm8) {
+            // The file's codes again: the dequantized weights map back exactly (round to nearest).
+            for (size_t i = 0; i < size_t(n) * 4; ++i) {
+                const double scale = d.u8Scale[k * 4 + i % 4], offset = d.u8Offset[k * 4 + i % 4];
+                const double code = scale > 0 ? std::nearbyint((double(w[i]) - offset) / scale) : 0.0;
+                codes[i] = static_cast<uint8_t>(std::clamp(code, 0.0, 255.0));
+            }
+            data = codes.data();
         } else {
-            m->weightTex.push_back(makeTexture2D(weightFormat, m->muW, m->muH, GL_RGBA, GL_FLOAT,
-                                                 padded.data(), GL_NEAREST));
+            std::memcpy(padded.data(), w, static_cast<size_t>(n) * 4 * sizeof(float));
         }
+        if (m->limits.weightArray)
+            glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, k, m->muW, m->muH, 1, GL_RGBA, type, data);
+        else
+            m->weightTex.push_back(makeTexture2D(internal, m->muW, m->muH, GL_RGBA, type, data, GL_NEAREST));
     }
-    // rho: which sample (or correction) each texel shows; RhoTexel is four uint32.
-    static_assert(sizeof(RhoTexel) == 4 * sizeof(uint32_t));
-    m->rhoIndexTex = makeTexture2D(GL_RGBA32UI, m->rhoW, m->rhoH, GL_RGBA_INTEGER,
-                                   GL_UNSIGNED_INT, L.rho.data(), GL_NEAREST);
     // Neighbour lists (CSR) for smoothing.
     if (!L.neighbourIndex.empty() && L.neighbourOffset.size() == static_cast<size_t>(n)) {
-        std::vector<uint32_t> range(static_cast<size_t>(m->muW) * m->muH * 2, 0);
+        std::vector<uint32_t> range(muTexels * 2, 0);
         for (int i = 0; i < n; ++i) {
             range[2 * i] = L.neighbourOffset[i];
             range[2 * i + 1] = L.neighbourCount[i];
@@ -238,39 +352,104 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
                                         wts.data(), GL_NEAREST);
         m->memory.neighbours = muTexels * 8 + idx.size() * 4 + wts.size() * 4;
     }
-    m->localView.create(m->muW, m->muH, GL_NEAREST);
-    m->sum[0].create(m->muW, m->muH, GL_NEAREST);
-    m->sum[1].create(m->muW, m->muH, GL_NEAREST);
-    m->smoothed.create(m->muW, m->muH, GL_NEAREST);
-    m->rho.create(m->rhoW, m->rhoH, GL_LINEAR);
-    m->memory.targets = 4 * muTexels * 16 + static_cast<size_t>(m->rhoW) * m->rhoH * 16;
+    // Texture-space targets: the vertex-decompression direct path needs none (until smoothing,
+    // refractionMap() or readDirectionalMap() asks for D_mu: decompressInTextureSpace).
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 
     // Fixed programs.
     m->viewProgram = buildProgram(shaders::source("fullscreen.vert"), shaders::source("local_view.frag"), "local view");
     glUseProgram(m->viewProgram);
-    glUniform1i(glGetUniformLocation(m->viewProgram, "uPosition"), 0);
-    glUniform1i(glGetUniformLocation(m->viewProgram, "uNormal"), 1);
+    setInt(m->viewProgram, "uPosition", 0);
+    setInt(m->viewProgram, "uNormal", 1);
     m->smoothProgram = buildProgram(shaders::source("fullscreen.vert"), shaders::source("smooth.frag"), "smoothing");
     glUseProgram(m->smoothProgram);
     const char* smoothSamplers[] = {"uD", "uRange", "uNbrIndex", "uNbrWeight"};
-    for (int u = 0; u < 4; ++u)
-        glUniform1i(glGetUniformLocation(m->smoothProgram, smoothSamplers[u]), u);
-    glUniform1i(glGetUniformLocation(m->smoothProgram, "uMuWidth"), m->muW);
-    glUniform1i(glGetUniformLocation(m->smoothProgram, "uListWidth"), m->listWidth);
-    m->unpackProgram = buildProgram(shaders::source("fullscreen.vert"), shaders::source("unpack.frag"), "unpack");
-    glUseProgram(m->unpackProgram);
-    glUniform1i(glGetUniformLocation(m->unpackProgram, "uRhoIndex"), 0);
-    glUniform1i(glGetUniformLocation(m->unpackProgram, "uD"), 1);
-    glUniform1i(glGetUniformLocation(m->unpackProgram, "uMuWidth"), m->muW);
-    m->shadeProgram = buildProgram(shaders::source("shade.vert"), shaders::source("shade.frag"), "shading");
-    glUseProgram(m->shadeProgram);
-    glUniform1i(glGetUniformLocation(m->shadeProgram, "uRho"), 0);
-    glUniform1i(glGetUniformLocation(m->shadeProgram, "uEnvironment"), 1);
-    glUseProgram(0);
+    for (int u = 0; u < 4; ++u) setInt(m->smoothProgram, smoothSamplers[u], u);
+    setInt(m->smoothProgram, "uMuWidth", m->muW);
+    setInt(m->smoothProgram, "uListWidth", m->listWidth);
 
-    // The mesh to draw, rebuilt from rho and the samples: triangle t's corners are its grid
-    // samples (0,0), (r,0), (0,r); UVs point at their texel centres in rho.
+    glGenVertexArrays(1, &m->emptyVao);
+    glGenQueries(kStages, m->queries);
+    if (m->direct) {
+        // The refined mesh: one vertex per mu sample (no attributes: gl_VertexID), and every
+        // triangle's regular barycentric subdivision at rate r as indices; both halves of a grid
+        // cell keep the triangle's winding (corner 0 -> 1 -> 2).
+        const int r = L.rate;
+        std::vector<uint32_t> indices;
+        indices.reserve(static_cast<size_t>(L.triangleCount) * r * r * 3);
+        for (int t = 0; t < L.triangleCount; ++t)
+            for (int j = 0; j < r; ++j)
+                for (int i = 0; i + j < r; ++i) {
+                    indices.insert(indices.end(), {L.sampleAt(t, i, j), L.sampleAt(t, i + 1, j),
+                                                   L.sampleAt(t, i, j + 1)});
+                    if (i + j + 1 < r)
+                        indices.insert(indices.end(), {L.sampleAt(t, i + 1, j), L.sampleAt(t, i + 1, j + 1),
+                                                       L.sampleAt(t, i, j + 1)});
+                }
+        m->directIndexCount = static_cast<int>(indices.size());
+        glGenVertexArrays(1, &m->directVao);
+        glBindVertexArray(m->directVao);
+        glGenBuffers(1, &m->directIbo);
+        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, m->directIbo);
+        glBufferData(GL_ELEMENT_ARRAY_BUFFER, indices.size() * sizeof(uint32_t), indices.data(),
+                     GL_STATIC_DRAW);
+        glBindVertexArray(0);
+        m->memory.mesh = indices.size() * sizeof(uint32_t);
+        if (!m->vertexMode()) m->directTextureProgram();
+    } else {
+        m->ensureRhoResources();
+        m->buildRhoMesh();
+    }
+    glUseProgram(0);
+    m->compiledFor(m->order);
+    SHREFRACT_GL_CHECK();
+    return std::unique_ptr<Refractor>(new Refractor(std::move(m)));
+}
+
+// The direct shading that fetches D_mu per vertex (texture-space decompression), on first use.
+GLuint Refractor::Impl::directTextureProgram() {
+    if (shadeDirectProgram) return shadeDirectProgram;
+    shadeDirectProgram = buildProgram(
+        shaders::source("shade_direct.vert"),
+        shaders::withVersion(shaders::source("shade.frag"), "330 core", "#define SHREFRACT_DIRECT"),
+        "direct shading");
+    glUseProgram(shadeDirectProgram);
+    setInt(shadeDirectProgram, "uD", 1);
+    setInt(shadeDirectProgram, "uPosition", 2);
+    setInt(shadeDirectProgram, "uNormal", 3);
+    setInt(shadeDirectProgram, "uMuWidth", muW);
+    return shadeDirectProgram;
+}
+
+// rho: the index texture, the target and the unpack program. Made at creation on the rho path,
+// on request (refractionMap()) on the direct path.
+void Refractor::Impl::ensureRhoResources() {
+    if (rhoIndexTex) return;
+    const SurfaceLayout& L = bake.data().layout;
+    // Which sample (or correction) each texel shows; RhoTexel is four uint32.
+    static_assert(sizeof(RhoTexel) == 4 * sizeof(uint32_t));
+    rhoIndexTex = makeTexture2D(GL_RGBA32UI, rhoW, rhoH, GL_RGBA_INTEGER, GL_UNSIGNED_INT,
+                                L.rho.data(), GL_NEAREST);
+    memory.rho = static_cast<size_t>(rhoW) * rhoH * 16;
+    rho.create(rhoW, rhoH, GL_LINEAR);
+    memory.targets += static_cast<size_t>(rhoW) * rhoH * 16;
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    unpackProgram = buildProgram(shaders::source("fullscreen.vert"), shaders::source("unpack.frag"), "unpack");
+    glUseProgram(unpackProgram);
+    setInt(unpackProgram, "uRhoIndex", 0);
+    setInt(unpackProgram, "uD", 1);
+    setInt(unpackProgram, "uMuWidth", muW);
+    glUseProgram(0);
+}
+
+// The rho path's shading: its program and the mesh rebuilt from rho and the samples: triangle
+// t's corners are its grid samples (0,0), (r,0), (0,r); UVs point at their texel centres in rho.
+void Refractor::Impl::buildRhoMesh() {
+    const SurfaceLayout& L = bake.data().layout;
+    shadeRhoProgram = buildProgram(shaders::source("shade.vert"), shaders::source("shade.frag"), "shading");
+    glUseProgram(shadeRhoProgram);
+    setInt(shadeRhoProgram, "uRho", 1);
+    glUseProgram(0);
     const int r = L.rate;
     std::vector<float> vertices;
     vertices.reserve(static_cast<size_t>(L.triangleCount) * 3 * 8);
@@ -280,17 +459,16 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
             uint32_t s = L.sampleAt(t, c.x, c.y);
             glm::ivec2 texel = L.rhoTexel(t, c.x, c.y);
             glm::vec3 p = L.position[s], nn = L.normal[s];
-            float v[8] = {p.x, p.y, p.z, nn.x, nn.y, nn.z, (texel.x + 0.5f) / m->rhoW,
-                          (texel.y + 0.5f) / m->rhoH};
+            float v[8] = {p.x, p.y, p.z, nn.x, nn.y, nn.z, (texel.x + 0.5f) / rhoW,
+                          (texel.y + 0.5f) / rhoH};
             vertices.insert(vertices.end(), v, v + 8);
         }
     }
-    m->vertexCount = L.triangleCount * 3;
-    glGenVertexArrays(1, &m->emptyVao);
-    glGenVertexArrays(1, &m->meshVao);
-    glBindVertexArray(m->meshVao);
-    glGenBuffers(1, &m->meshVbo);
-    glBindBuffer(GL_ARRAY_BUFFER, m->meshVbo);
+    rhoVertexCount = L.triangleCount * 3;
+    glGenVertexArrays(1, &rhoVao);
+    glBindVertexArray(rhoVao);
+    glGenBuffers(1, &rhoVbo);
+    glBindBuffer(GL_ARRAY_BUFFER, rhoVbo);
     glBufferData(GL_ARRAY_BUFFER, vertices.size() * sizeof(float), vertices.data(), GL_STATIC_DRAW);
     for (int a = 0; a < 3; ++a) glEnableVertexAttribArray(a);
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 8 * sizeof(float), nullptr);
@@ -299,10 +477,7 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
     glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, 8 * sizeof(float),
                           reinterpret_cast<void*>(6 * sizeof(float)));
     glBindVertexArray(0);
-    glGenQueries(kStages, m->queries);
-    m->compiledFor(m->order);
-    SHREFRACT_GL_CHECK();
-    return std::unique_ptr<Refractor>(new Refractor(std::move(m)));
+    memory.mesh = vertices.size() * sizeof(float);
 }
 
 Refractor::~Refractor() {
@@ -312,10 +487,13 @@ Refractor::~Refractor() {
     } catch (...) {
         return;  // no GL any more: nothing to release safely
     }
-    for (auto& [L, c] : m.compiled)
+    for (auto& [L, c] : m.compiled) {
         for (GLuint p : c.programs) glDeleteProgram(p);
-    for (GLuint p : {m.viewProgram, m.smoothProgram, m.unpackProgram, m.shadeProgram})
-        glDeleteProgram(p);
+        if (c.shadeVertexSh) glDeleteProgram(c.shadeVertexSh);
+    }
+    for (GLuint p : {m.viewProgram, m.smoothProgram, m.unpackProgram, m.shadeRhoProgram,
+                     m.shadeDirectProgram})
+        if (p) glDeleteProgram(p);
     GLuint textures[] = {m.positionTex, m.normalTex, m.weightArray, m.rhoIndexTex,
                          m.rangeTex,    m.nbrIndexTex, m.nbrWeightTex};
     for (GLuint t : textures)
@@ -323,10 +501,107 @@ Refractor::~Refractor() {
     if (!m.weightTex.empty())
         glDeleteTextures(static_cast<GLsizei>(m.weightTex.size()), m.weightTex.data());
     for (Target* t : {&m.localView, &m.sum[0], &m.sum[1], &m.smoothed, &m.rho}) t->destroy();
-    glDeleteVertexArrays(1, &m.emptyVao);
-    glDeleteVertexArrays(1, &m.meshVao);
-    glDeleteBuffers(1, &m.meshVbo);
+    for (GLuint v : {m.emptyVao, m.rhoVao, m.directVao})
+        if (v) glDeleteVertexArrays(1, &v);
+    for (GLuint b : {m.rhoVbo, m.directIbo})
+        if (b) glDeleteBuffers(1, &b);
     glDeleteQueries(kStages, m.queries);
+}
+
+void Refractor::Impl::decompressInTextureSpace(bool timed) {
+    const size_t muBytes = static_cast<size_t>(muW) * muH * 16;  // one RGBA32F mu target
+    if (!localView.fbo) {  // made on first use
+        localView.create(muW, muH, GL_NEAREST);
+        sum[0].create(muW, muH, GL_NEAREST);
+        sum[1].create(muW, muH, GL_NEAREST);
+        memory.targets += 3 * muBytes;
+    }
+    if (smoothing && rangeTex && !smoothed.fbo) {
+        smoothed.create(muW, muH, GL_NEAREST);
+        memory.targets += muBytes;
+    }
+    const bool timing = timed && options.timings;
+    auto begin = [&](Stage s) {
+        if (timing) this->begin(s);
+    };
+    auto end = [&](Stage s, double* ms) {
+        if (timing) this->end(s, ms);
+    };
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    glBindVertexArray(emptyVao);
+    glViewport(0, 0, muW, muH);
+
+    // The local view direction per sample.
+    begin(kView);
+    glBindFramebuffer(GL_FRAMEBUFFER, localView.fbo);
+    glUseProgram(viewProgram);
+    glUniform3f(glGetUniformLocation(viewProgram, "uEye"), lastEye.x, lastEye.y, lastEye.z);
+    bindTexture(0, GL_TEXTURE_2D, positionTex);
+    bindTexture(1, GL_TEXTURE_2D, normalTex);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    end(kView, &timings.view);
+
+    // D_mu: the generated passes, partial sums ping-ponging between sum[0] and sum[1].
+    const Compiled& c = compiledFor(order);
+    begin(kDecompress);
+    for (size_t i = 0; i < c.programs.size(); ++i) {
+        const DecompressionPass& pass = c.shaders.passes[i];
+        glBindFramebuffer(GL_FRAMEBUFFER, sum[i % 2].fbo);
+        glUseProgram(c.programs[i]);
+        for (size_t u = 0; u < pass.samplers.size(); ++u) {
+            const SamplerBinding& s = pass.samplers[u];
+            int unit = static_cast<int>(u);
+            switch (s.kind) {
+                case SamplerBinding::LocalView:
+                    bindTexture(unit, GL_TEXTURE_2D, localView.texture);
+                    break;
+                case SamplerBinding::PartialSum:
+                    bindTexture(unit, GL_TEXTURE_2D, sum[(i + 1) % 2].texture);
+                    break;
+                case SamplerBinding::Weight:
+                    bindTexture(unit, GL_TEXTURE_2D, weightTex[s.coefficient]);
+                    break;
+                case SamplerBinding::WeightArray:
+                    bindTexture(unit, GL_TEXTURE_2D_ARRAY, weightArray);
+                    break;
+            }
+        }
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+    }
+    end(kDecompress, &timings.decompress);
+    if (timed) timings.passes = static_cast<int>(c.programs.size());
+    lastD = sum[(c.programs.size() + 1) % 2].texture;
+
+    // Optional spatial smoothing through the neighbour lists.
+    if (timed) timings.smooth = 0;
+    if (smoothing && rangeTex) {
+        begin(kSmooth);
+        glBindFramebuffer(GL_FRAMEBUFFER, smoothed.fbo);
+        glUseProgram(smoothProgram);
+        bindTexture(0, GL_TEXTURE_2D, lastD);
+        bindTexture(1, GL_TEXTURE_2D, rangeTex);
+        bindTexture(2, GL_TEXTURE_2D, nbrIndexTex);
+        bindTexture(3, GL_TEXTURE_2D, nbrWeightTex);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        end(kSmooth, &timings.smooth);
+        lastD = smoothed.texture;
+    }
+}
+
+void Refractor::Impl::unpackRho(bool timed) {
+    const bool timing = timed && options.timings;
+    if (timing) begin(kUnpack);
+    glViewport(0, 0, rhoW, rhoH);
+    glBindFramebuffer(GL_FRAMEBUFFER, rho.fbo);
+    glBindVertexArray(emptyVao);
+    glUseProgram(unpackProgram);
+    setInt(unpackProgram, "uCorrection", correction ? 1 : 0);
+    bindTexture(0, GL_TEXTURE_2D, rhoIndexTex);
+    bindTexture(1, GL_TEXTURE_2D, lastD);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    if (timing) end(kUnpack, &timings.unpack);
+    rhoReady = true;
 }
 
 void Refractor::update(glm::vec3 eye, const glm::mat4& model) {
@@ -335,83 +610,21 @@ void Refractor::update(glm::vec3 eye, const glm::mat4& model) {
     GLint viewport[4], framebuffer = 0;
     glGetIntegerv(GL_VIEWPORT, viewport);
     glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &framebuffer);
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_BLEND);
-    glBindVertexArray(m.emptyVao);
-    glViewport(0, 0, m.muW, m.muH);
-
-    // Eye to object space, then the local view direction per sample.
-    glm::vec3 eyeObject = glm::vec3(glm::inverse(model) * glm::vec4(eye, 1.0f));
-    m.begin(kView);
-    glBindFramebuffer(GL_FRAMEBUFFER, m.localView.fbo);
-    glUseProgram(m.viewProgram);
-    glUniform3f(glGetUniformLocation(m.viewProgram, "uEye"), eyeObject.x, eyeObject.y,
-                eyeObject.z);
-    bindTexture(0, GL_TEXTURE_2D, m.positionTex);
-    bindTexture(1, GL_TEXTURE_2D, m.normalTex);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    m.end(kView, &m.timings.view);
-
-    // D_mu: the generated passes, partial sums ping-ponging between sum[0] and sum[1].
-    const Impl::Compiled& c = m.compiledFor(m.order);
-    m.begin(kDecompress);
-    for (size_t i = 0; i < c.programs.size(); ++i) {
-        const DecompressionPass& pass = c.shaders.passes[i];
-        glBindFramebuffer(GL_FRAMEBUFFER, m.sum[i % 2].fbo);
-        glUseProgram(c.programs[i]);
-        for (size_t u = 0; u < pass.samplers.size(); ++u) {
-            const SamplerBinding& s = pass.samplers[u];
-            int unit = static_cast<int>(u);
-            switch (s.kind) {
-                case SamplerBinding::LocalView:
-                    bindTexture(unit, GL_TEXTURE_2D, m.localView.texture);
-                    break;
-                case SamplerBinding::PartialSum:
-                    bindTexture(unit, GL_TEXTURE_2D, m.sum[(i + 1) % 2].texture);
-                    break;
-                case SamplerBinding::Weight:
-                    bindTexture(unit, GL_TEXTURE_2D, m.weightTex[s.coefficient]);
-                    break;
-                case SamplerBinding::WeightArray:
-                    bindTexture(unit, GL_TEXTURE_2D_ARRAY, m.weightArray);
-                    break;
-            }
+    m.lastEye = glm::vec3(glm::inverse(model) * glm::vec4(eye, 1.0f));  // eye to object space
+    m.rhoReady = false;
+    m.timings = Timings{};
+    if (m.vertexMode()) {
+        // Everything happens in draw(); an app that asked for the refraction map keeps getting it.
+        if (m.rhoIndexTex) {
+            m.decompressInTextureSpace(false);
+            m.unpackRho(false);
         }
-        glDrawArrays(GL_TRIANGLES, 0, 3);
+    } else {
+        m.decompressInTextureSpace(true);
+        // The rho path unpacks every frame; the direct path only for an app that asked for it.
+        if (!m.direct) m.unpackRho(true);
+        else if (m.rhoIndexTex) m.unpackRho(false);
     }
-    m.end(kDecompress, &m.timings.decompress);
-    m.timings.passes = static_cast<int>(c.programs.size());
-    const Target& d = m.sum[(c.programs.size() + 1) % 2];
-    m.lastD = d.texture;
-    m.lastDFbo = d.fbo;
-
-    // Optional spatial smoothing through the neighbour lists.
-    m.timings.smooth = 0;
-    if (m.smoothing && m.rangeTex) {
-        m.begin(kSmooth);
-        glBindFramebuffer(GL_FRAMEBUFFER, m.smoothed.fbo);
-        glUseProgram(m.smoothProgram);
-        bindTexture(0, GL_TEXTURE_2D, d.texture);
-        bindTexture(1, GL_TEXTURE_2D, m.rangeTex);
-        bindTexture(2, GL_TEXTURE_2D, m.nbrIndexTex);
-        bindTexture(3, GL_TEXTURE_2D, m.nbrWeightTex);
-        glDrawArrays(GL_TRIANGLES, 0, 3);
-        m.end(kSmooth, &m.timings.smooth);
-        m.lastD = m.smoothed.texture;
-        m.lastDFbo = m.smoothed.fbo;
-    }
-
-    // Unpack into rho, writing the correction texels.
-    m.begin(kUnpack);
-    glViewport(0, 0, m.rhoW, m.rhoH);
-    glBindFramebuffer(GL_FRAMEBUFFER, m.rho.fbo);
-    glUseProgram(m.unpackProgram);
-    glUniform1i(glGetUniformLocation(m.unpackProgram, "uCorrection"), m.correction ? 1 : 0);
-    bindTexture(0, GL_TEXTURE_2D, m.rhoIndexTex);
-    bindTexture(1, GL_TEXTURE_2D, m.lastD);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    m.end(kUnpack, &m.timings.unpack);
-
     glUseProgram(0);
     glBindVertexArray(0);
     glActiveTexture(GL_TEXTURE0);
@@ -427,9 +640,10 @@ void Refractor::draw(const glm::mat4& view, const glm::mat4& projection, const g
     m.begin(kShade);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
-    glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
-    glUseProgram(m.shadeProgram);
-    GLuint p = m.shadeProgram;
+    GLuint p = !m.direct          ? m.shadeRhoProgram
+               : m.vertexMode()   ? m.compiledFor(m.order).shadeVertexSh
+                                  : m.directTextureProgram();
+    glUseProgram(p);
     glm::mat4 vp = projection * view;
     glm::mat3 rotation(model);
     glm::mat3 normalMatrix = glm::inverseTranspose(rotation);
@@ -441,15 +655,32 @@ void Refractor::draw(const glm::mat4& view, const glm::mat4& projection, const g
     glUniformMatrix3fv(glGetUniformLocation(p, "uModelRotation"), 1, GL_FALSE,
                        glm::value_ptr(rotation));
     glUniform3f(glGetUniformLocation(p, "uEye"), eye.x, eye.y, eye.z);
-    glUniform1f(glGetUniformLocation(p, "uEta"), m.bake.ior());
+    setFloat(p, "uEta", m.bake.ior());
     glm::vec3 kappa = m.bake.absorption();
     glUniform3f(glGetUniformLocation(p, "uKappa"), kappa.x, kappa.y, kappa.z);
-    glUniform1i(glGetUniformLocation(p, "uToneMap"), m.options.toneMap ? 1 : 0);
-    glUniform1f(glGetUniformLocation(p, "uExposure"), m.options.exposure);
-    bindTexture(0, GL_TEXTURE_2D, m.rho.texture);
-    bindTexture(1, GL_TEXTURE_CUBE_MAP, environment.cubeMap());
-    glBindVertexArray(m.meshVao);
-    glDrawArrays(GL_TRIANGLES, 0, m.vertexCount);
+    setInt(p, "uToneMap", m.options.toneMap ? 1 : 0);
+    setFloat(p, "uExposure", m.options.exposure);
+    setInt(p, "uSpread", m.spread ? 1 : 0);
+    setFloat(p, "uSpreadScale", m.options.spreadScale);
+    setFloat(p, "uFootprintScale", m.options.footprintScale);
+    useEnvironment(p, environment, 0);
+    if (m.direct) {
+        bindTexture(1, GL_TEXTURE_2D, m.lastD);
+        bindTexture(2, GL_TEXTURE_2D, m.positionTex);
+        bindTexture(3, GL_TEXTURE_2D, m.normalTex);
+        if (m.vertexMode()) {
+            // Eye in object space, and the weights from unit 4 on (compiledFor's assignment).
+            const glm::vec3 e = glm::vec3(glm::inverse(model) * glm::vec4(eye, 1.0f));
+            glUniform3f(glGetUniformLocation(p, "uEyeObject"), e.x, e.y, e.z);
+            m.bindWeights(m.compiledFor(m.order).shaders.passes[0], 4);
+        }
+        glBindVertexArray(m.directVao);
+        glDrawElements(GL_TRIANGLES, m.directIndexCount, GL_UNSIGNED_INT, nullptr);
+    } else {
+        bindTexture(1, GL_TEXTURE_2D, m.rho.texture);
+        glBindVertexArray(m.rhoVao);
+        glDrawArrays(GL_TRIANGLES, 0, m.rhoVertexCount);
+    }
     glBindVertexArray(0);
     glUseProgram(0);
     glActiveTexture(GL_TEXTURE0);
@@ -457,8 +688,27 @@ void Refractor::draw(const glm::mat4& view, const glm::mat4& projection, const g
     SHREFRACT_GL_CHECK();
 }
 
-unsigned Refractor::refractionMap() const { return impl_->rho.texture; }
+unsigned Refractor::refractionMap() {
+    Impl& m = *impl_;
+    m.use();
+    if (!m.rhoReady) {
+        GLint viewport[4], framebuffer = 0;
+        glGetIntegerv(GL_VIEWPORT, viewport);
+        glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &framebuffer);
+        m.ensureRhoResources();
+        if (m.vertexMode()) m.decompressInTextureSpace(false);
+        m.unpackRho(false);
+        glUseProgram(0);
+        glBindVertexArray(0);
+        glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+        glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
+    }
+    return m.rho.texture;
+}
+
 glm::ivec2 Refractor::refractionMapSize() const { return {impl_->rhoW, impl_->rhoH}; }
+std::string Refractor::path() const { return impl_->direct ? "direct" : "rho"; }
+std::string Refractor::decompression() const { return impl_->vertexMode() ? "vertex" : "texture"; }
 
 void Refractor::setOrder(int L) {
     impl_->use();
@@ -466,7 +716,12 @@ void Refractor::setOrder(int L) {
     impl_->compiledFor(impl_->order);
 }
 int Refractor::order() const { return impl_->order; }
-void Refractor::setSmoothing(bool on) { impl_->smoothing = on; }
+void Refractor::setSmoothing(bool on) {
+    if (on && impl_->vertexShRequired)
+        throw std::invalid_argument(
+            "shrefract: smoothing needs texture-space decompression (decompression \"vertex\" was asked for)");
+    impl_->smoothing = on;
+}
 void Refractor::setCorrection(bool on) { impl_->correction = on; }
 void Refractor::setTimings(bool on) {
     if (!on) impl_->timings = Timings{};
@@ -475,7 +730,7 @@ void Refractor::setTimings(bool on) {
 const Timings& Refractor::timings() const { return impl_->timings; }
 const GpuMemory& Refractor::memory() const { return impl_->memory; }
 int Refractor::passCount() const {
-    return static_cast<int>(impl_->compiledFor(impl_->order).programs.size());
+    return impl_->vertexMode() ? 0 : static_cast<int>(impl_->compiledFor(impl_->order).programs.size());
 }
 
 std::string Refractor::form() const {
@@ -497,22 +752,34 @@ static std::vector<float> readTexture(GLuint texture, int w, int h) {
 }
 
 std::vector<float> Refractor::readDirectionalMap() const {
-    impl_->use();
-    std::vector<float> all = readTexture(impl_->lastD, impl_->muW, impl_->muH);
-    all.resize(static_cast<size_t>(impl_->bake.sampleCount()) * 4);
+    Impl& m = *impl_;
+    m.use();
+    if (m.vertexMode()) {
+        // The same generated shPass(), run in texture space for the last eye.
+        GLint viewport[4], framebuffer = 0;
+        glGetIntegerv(GL_VIEWPORT, viewport);
+        glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &framebuffer);
+        m.decompressInTextureSpace(false);
+        glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+        glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
+    }
+    std::vector<float> all = readTexture(m.lastD, m.muW, m.muH);
+    all.resize(static_cast<size_t>(m.bake.sampleCount()) * 4);
     return all;
 }
 
 std::vector<float> Refractor::readLocalViewMap() const {
     impl_->use();
+    if (!impl_->localView.texture) readDirectionalMap();
     std::vector<float> all = readTexture(impl_->localView.texture, impl_->muW, impl_->muH);
     all.resize(static_cast<size_t>(impl_->bake.sampleCount()) * 4);
     return all;
 }
 
-std::vector<float> Refractor::readRefractionMap() const {
+std::vector<float> Refractor::readRefractionMap() {
     impl_->use();
-    return readTexture(impl_->rho.texture, impl_->rhoW, impl_->rhoH);
+    const GLuint t = refractionMap();
+    return readTexture(t, impl_->rhoW, impl_->rhoH);
 }
 
 }  // namespace shrefract

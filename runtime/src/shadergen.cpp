@@ -204,12 +204,18 @@ std::string generatedPass(const DecompressionShaders& s, int index, const PassPl
             pass.samplers.push_back({SamplerBinding::Weight, k, name});
         }
     }
+    const int K = static_cast<int>(polys.size());
+    if (l.unormWeights)
+        o << "uniform vec4 uWeightScale[" << K << "];   // 8-bit weights: value = code / 255 * scale + offset\n"
+          << "uniform vec4 uWeightOffset[" << K << "];\n";
     o << "\n"
       << "vec4 shPass(ivec2 p, vec3 w, vec4 s) {\n"
       << "    float x = w.x, y = w.y, z = w.z;\n";
     auto fetch = [&](int k) {
-        return l.weightArray ? "texelFetch(uWeights, ivec3(p, " + std::to_string(k) + "), 0)"
-                             : "texelFetch(uWeight" + std::to_string(k) + ", p, 0)";
+        const std::string kk = std::to_string(k);
+        const std::string t = l.weightArray ? "texelFetch(uWeights, ivec3(p, " + kk + "), 0)"
+                                            : "texelFetch(uWeight" + kk + ", p, 0)";
+        return l.unormWeights ? "(" + t + " * uWeightScale[" + kk + "] + uWeightOffset[" + kk + "])" : t;
     };
     if (s.form == ShForm::Recurrence) {
         const RecurrenceSet& r = plan.rec;
@@ -270,18 +276,18 @@ std::string generatedPass(const DecompressionShaders& s, int index, const PassPl
 // The whole fragment shader of pass `index`: shaders/decompress.frag with the generated part.
 std::string fragmentSource(const DecompressionShaders& s, int index, const PassPlan& plan,
                            const std::vector<ShPolynomial>& polys, DecompressionPass& pass) {
-    const std::string generated = generatedPass(s, index, plan, polys, pass);
+    pass.generated = generatedPass(s, index, plan, polys, pass);
     return shaders::withVersion(
-        shaders::fill(shaders::source("decompress.frag"), "#pragma shrefract_generated", generated),
+        shaders::fill(shaders::source("decompress.frag"), "#pragma shrefract_generated", pass.generated),
         s.limits.version, index == 0 ? "#define SHREFRACT_FIRST_PASS" : "");
 }
 
 int functionAlu(const ShPolynomial& p) { return static_cast<int>(p.terms.size()) + 1; }
 
 // ALU that function p adds to `plan` in `form` (and adds what it needs to the plan).
-int addFunction(PassPlan& plan, const ShPolynomial& p, ShForm form) {
-    if (form == ShForm::Recurrence) return plan.rec.add(p.l, p.m) + (p.m == 0 ? 1 : 2);
-    int c = functionAlu(p);
+int addFunction(PassPlan& plan, const ShPolynomial& p, ShForm form, bool unorm) {
+    if (form == ShForm::Recurrence) return plan.rec.add(p.l, p.m) + (p.m == 0 ? 1 : 2) + unorm;
+    int c = functionAlu(p) + unorm;
     for (const Monomial& t : p.terms) c += plan.monos.add({t.a, t.b, t.c});
     return c;
 }
@@ -308,7 +314,7 @@ DecompressionShaders generateForm(int order, const ShaderLimits& limits, ShForm 
     std::vector<int> standalone(K);
     for (int k = 0; k < K; ++k) {
         PassPlan alone;
-        standalone[k] = addFunction(alone, polys[k], form);
+        standalone[k] = addFunction(alone, polys[k], form, limits.unormWeights);
     }
     std::vector<int> byCost(K);
     std::iota(byCost.begin(), byCost.end(), 0);
@@ -325,7 +331,7 @@ DecompressionShaders generateForm(int order, const ShaderLimits& limits, ShForm 
             if (fresh) trial.units += pi == 0 ? 0 : 1;  // partial sum for every later pass
             if (fresh && limits.weightArray) trial.units += 1;
             if (!limits.weightArray) trial.units += 1;
-            trial.alu += addFunction(trial, polys[k], form);
+            trial.alu += addFunction(trial, polys[k], form, limits.unormWeights);
             bool fits = trial.units <= limits.maxTextureUnits &&
                         (!aluLimited || trial.alu <= limits.maxAluInstructions);
             if (!fits) {

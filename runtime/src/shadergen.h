@@ -40,6 +40,9 @@ struct ShaderLimits {
     int maxAluInstructions = 0;   // cost-model estimate per pass; <= 0: unlimited
     bool weightArray = true;      // all weights in one sampler2DArray (one unit)
     std::string version = "330 core";  // the #version line
+    // The weights are RGBA8 UNORM codes (8-bit bakes uploaded as stored): each fetch becomes
+    // texel * uWeightScale[k] + uWeightOffset[k] (per-coefficient uniforms; +1 ALU a function).
+    bool unormWeights = false;
 };
 
 // "2006": the ATI R300 class the paper used (Radeon 9700: 16 samplers, 64 ALU instructions per
@@ -84,7 +87,12 @@ struct DecompressionPass {
     std::vector<int> functions;  // even indices k, ascending
     int aluCost = 0;
     std::vector<SamplerBinding> samplers;
-    std::string fragment;  // GLSL
+    // The generated part alone: the weight samplers (and u8 scale/offset uniforms) and
+    //   vec4 shPass(ivec2 p, vec3 w, vec4 s)
+    // returning s plus weight(p) x y_k(w) for this pass's functions. Any template with the line
+    // "#pragma shrefract_generated" can take it (shaders/decompress.frag, shade_direct.vert).
+    std::string generated;
+    std::string fragment;  // the whole fragment shader: shaders/decompress.frag filled in
 };
 
 struct DecompressionShaders {

@@ -39,7 +39,9 @@ Bake loadBake(const std::string& path, bool verify = true);
 // Wraps bake data already in memory (tests, tools that bake and render in one process).
 Bake makeBake(BakeData data);
 
-// An HDR environment as a GL cube map (RGB16F... RGB32F, linear filtering, seamless).
+// An HDR environment as a GL cube map (RGB32F, seamless), with a mip chain prefiltered for spread
+// shading: level l >= 1 is level 0 convolved with a vMF lobe one texel of that level wide
+// (docs/runtime.md "Spread shading"; built on the CPU at load, about a third more memory).
 // Lat-long convention: +y up; u = 0.5 + atan2(d.x, -d.z) / 2pi, v = acos(d.y) / pi (row 0 top).
 class Environment {
 public:
@@ -52,7 +54,8 @@ public:
     Environment& operator=(Environment&&) noexcept;
     ~Environment();
     unsigned cubeMap() const { return texture_; }  // GL_TEXTURE_CUBE_MAP name
-    int faceSize() const { return faceSize_; }
+    int faceSize() const { return faceSize_; }  // of level 0
+    int levels() const { return levels_; }      // mip levels, down to 1 x 1
     // Draws the environment behind everything (no depth test, no depth write): linear HDR, or
     // display values through toneMap() when `toneMap` (match RefractorOptions::toneMap).
     void drawBackground(const glm::mat4& view, const glm::mat4& projection, bool toneMap = false,
@@ -61,7 +64,7 @@ public:
 private:
     Environment() = default;
     unsigned texture_ = 0, program_ = 0, vao_ = 0;
-    int faceSize_ = 0;
+    int faceSize_ = 0, levels_ = 1;
 };
 
 // HDR to display, documented once (docs/runtime.md): c * exposure, then the ACES filmic fit of
@@ -71,23 +74,24 @@ glm::vec3 toneMap(glm::vec3 hdr, float exposure = 1.0f);
 // GPU time per stage of the last update()/draw(), milliseconds (GL timer queries).
 struct Timings {
     double view = 0;        // eye -> local view direction per sample
-    double decompress = 0;  // D_mu, all generated passes
+    double decompress = 0;  // D_mu, all generated passes (0 when the vertex shader decompresses)
     double smooth = 0;      // neighbour-list smoothing (0 when off)
-    double unpack = 0;      // mu -> rho with correction texels
-    double shade = 0;       // draw()
-    int passes = 0;         // decompression passes used
+    double unpack = 0;      // mu -> rho with correction texels (rho path only)
+    double shade = 0;       // draw() (with the decompression, when the vertex shader does it)
+    int passes = 0;         // decompression passes used (0 when the vertex shader decompresses)
 };
 
-// GPU memory a Refractor allocated, bytes of texel storage at the internal formats it asked
-// for (drivers may pad): what paper Figure 12 counts.
+// GPU memory a Refractor allocated, bytes of texel and buffer storage at the internal formats it
+// asked for (drivers may pad): what paper Figure 12 counts.
 struct GpuMemory {
-    size_t weights = 0;     // SH weights of the uploaded bands, mu size each: RGBA32F for f32
-                            // bakes, RGBA16F for f16 and u8 bakes
+    size_t weights = 0;     // SH weights of the uploaded bands, mu size each, at the GPU format
+                            // (RGBA32F, RGBA16F or RGBA8: see RefractorOptions::halfWeights)
     size_t samples = 0;     // positions and normals, RGB32F, mu size
-    size_t rho = 0;         // rho index texture (which sample or correction per texel)
+    size_t rho = 0;         // rho index texture (rho path, or refractionMap() on the direct path)
     size_t neighbours = 0;  // smoothing lists (CSR)
-    size_t targets = 0;     // render targets: local view, two partial sums, smoothed, rho
-    size_t total() const { return weights + samples + rho + neighbours + targets; }
+    size_t mesh = 0;        // vertex and index buffers of the drawn mesh
+    size_t targets = 0;     // render targets: local view, partial sums, smoothed, rho
+    size_t total() const { return weights + samples + rho + neighbours + mesh + targets; }
 };
 
 struct RefractorOptions {
@@ -99,11 +103,29 @@ struct RefractorOptions {
     // preset's limits ("2006" above order 16), "auto" uses the polynomial and "recurrence"
     // throws std::invalid_argument.
     std::string form = "auto";
+    // How the refraction map is interpolated across triangles (docs/runtime.md "Interpolation
+    // paths"): "rho" is the paper's texture-space layout with correction texels and an unpack
+    // pass; "direct" draws the sample grid as a refined mesh and lets the rasterizer interpolate;
+    // "auto": direct for the modern preset, rho for 2006.
+    std::string path = "auto";
+    // Direct path: where the SH are evaluated. "vertex": in the shading pass's vertex shader (one
+    // draw; needs a one-pass preset and no smoothing); "texture": decompression passes into D_mu
+    // first; "auto": the measured default (docs/runtime.md).
+    std::string decompression = "auto";
     int order = -1;                 // SH order used, -1: all stored
     int maxOrder = -1;              // bands uploaded to the GPU, 0..maxOrder (-1: all stored);
                                     // setOrder() cannot go above it
+    // Float32 bakes upload as RGBA16F (half the memory). f16 bakes are always RGBA16F, u8 bakes
+    // RGBA8 with per-coefficient scale and offset applied in the shader (paper Figure 5).
+    bool halfWeights = false;
     bool smoothing = false;         // spatial smoothing through the bake's neighbour lists
     bool correction = true;         // interpolation-correction texels in rho (paper §5.3.1)
+    // "spread": where the SH reconstruction is short (the mapping scatters) the environment is
+    // averaged over a lobe of a prefiltered cube map, widened by the screen-space footprint;
+    // "sharp": the paper's single lookup along the exit direction (docs/runtime.md).
+    std::string shading = "spread";
+    float spreadScale = 1.0f;       // lobe width factor (spread shading)
+    float footprintScale = 0.5f;    // screen-space footprint factor (spread shading)
     bool timings = true;            // GL timer queries around every stage
     bool toneMap = false;           // draw() writes display values (toneMap()) instead of HDR
     float exposure = 1.0f;
@@ -121,8 +143,13 @@ public:
     // toneMap), world exit direction + coverage 1 to draw buffer 1 when one is bound.
     void draw(const glm::mat4& view, const glm::mat4& projection, const glm::mat4& model,
               const Environment& environment);
-    unsigned refractionMap() const;     // GL_TEXTURE_2D, RGBA32F rho layout, GL_LINEAR
+    // The refraction map for an app's own material: GL_TEXTURE_2D, RGBA32F, rho layout,
+    // GL_LINEAR (docs/integrate.md). On the direct path it is built on first request (rho index
+    // and target allocated then) and kept up to date by every later update().
+    unsigned refractionMap();
     glm::ivec2 refractionMapSize() const;
+    std::string path() const;           // "rho" or "direct"
+    std::string decompression() const;  // "texture" or "vertex"
     // Progressive decompression (paper §6): use bands 0..L, clamped to the uploaded maxOrder.
     void setOrder(int L);
     int order() const;
@@ -142,8 +169,9 @@ public:
     // Reads back the local view direction per sample after update() (4 floats per sample, xyz
     // used): what the decompression passes evaluated the SH at, for precision measurements.
     std::vector<float> readLocalViewMap() const;
-    // Reads back the refraction map, rho layout, RGBA row-major from row 0.
-    std::vector<float> readRefractionMap() const;
+    // Reads back the refraction map, rho layout, RGBA row-major from row 0 (builds it on the
+    // direct path, as refractionMap() does).
+    std::vector<float> readRefractionMap();
 
     struct Impl;
 

@@ -298,10 +298,15 @@ Mesh loadMesh(const std::string& path, MeshReport* report) {
 
     OMesh om;
     om.request_vertex_normals();
+    // Texture coordinates: per corner (OBJ `vt`: halfedge texcoords) or per vertex (PLY).
+    om.request_halfedge_texcoords2D();
+    om.request_vertex_texcoords2D();
     // With status present, OpenMesh's importer marks the faces it had to split off (below).
     om.request_vertex_status();
     om.request_face_status();
     OpenMesh::IO::Options options = OpenMesh::IO::Options::VertexNormal;
+    options += OpenMesh::IO::Options::FaceTexCoord;
+    options += OpenMesh::IO::Options::VertexTexCoord;
     std::string omMessages;
     bool readOk;
     {
@@ -336,20 +341,30 @@ Mesh loadMesh(const std::string& path, MeshReport* report) {
         uint32_t v = uint32_t(vh.idx());
         original[v] = om.status(vh).fixed_nonmanifold() ? weld[v] : v;
     }
+    // Corner texture coordinates: the file's per-corner ones (OBJ), else its per-vertex ones.
+    const bool cornerUVs = options.check(OpenMesh::IO::Options::FaceTexCoord);
+    const bool vertexUVs = !cornerUVs && options.check(OpenMesh::IO::Options::VertexTexCoord);
     std::vector<glm::uvec3> candidates;
+    std::vector<glm::vec2> candidateUVs;
     std::vector<bool> reconnected;
     candidates.reserve(om.n_faces());
     for (auto fh : om.faces()) {
         glm::uvec3 t;
+        glm::vec2 uv[3];
         int k = 0;
         bool copy = false;
-        for (auto vh : om.fv_range(fh)) {
+        // A face's halfedges in order point at its vertices in fv_range order.
+        for (auto heh : om.fh_range(fh)) {
             if (k == 3) break;
+            auto vh = om.to_vertex_handle(heh);
             copy |= original[size_t(vh.idx())] != uint32_t(vh.idx());
+            const auto& tc = cornerUVs ? om.texcoord2D(heh) : om.texcoord2D(vh);
+            uv[k] = glm::vec2(tc[0], tc[1]);
             t[k++] = original[size_t(vh.idx())];
         }
         if (k == 3) {
             candidates.push_back(t);
+            candidateUVs.insert(candidateUVs.end(), uv, uv + 3);
             reconnected.push_back(copy);
         }
     }
@@ -368,6 +383,8 @@ Mesh loadMesh(const std::string& path, MeshReport* report) {
             continue;
         }
         mesh.triangles.push_back(t);
+        if (cornerUVs || vertexUVs)
+            mesh.uvs.insert(mesh.uvs.end(), &candidateUVs[3 * i], &candidateUVs[3 * i] + 3);
         reconnectedKept += reconnected[i];
     }
     if (mesh.triangles.empty()) {
@@ -413,6 +430,7 @@ Mesh loadMesh(const std::string& path, MeshReport* report) {
         }
         if (volume6 < 0.0) {
             for (glm::uvec3& t : mesh.triangles) std::swap(t.y, t.z);
+            for (size_t c = 0; c < mesh.uvs.size(); c += 3) std::swap(mesh.uvs[c + 1], mesh.uvs[c + 2]);
             warn("triangles wound inward (negative volume): flipped so normals point outward");
         }
     }

@@ -13,6 +13,9 @@ struct Mesh {
     std::vector<glm::vec3> positions;
     std::vector<glm::vec3> normals;     // per vertex, unit length, outward
     std::vector<glm::uvec3> triangles;  // counter-clockwise seen from outside
+    // Texture coordinates per triangle corner (uvs[3 t + k] for corner k of triangle t), from the
+    // file (OBJ `vt`, PLY vertex `u v` or `s t`); empty when the file has none.
+    std::vector<glm::vec2> uvs;
     bool normalsFromFile = false;
 
     glm::vec3 boundsMin() const;

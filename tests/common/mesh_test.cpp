@@ -281,6 +281,51 @@ TEST(Mesh, InwardWoundClosedMeshIsFlipped) {
     EXPECT_NE(report.warnings[0].find("flipped"), std::string::npos);
 }
 
+// Texture coordinates per triangle corner: OBJ `vt` may differ at one vertex (a UV seam), PLY's
+// per-vertex `u v` are copied to every corner; dropped triangles and the inward flip keep every
+// corner with its own UV.
+TEST(Mesh, TextureCoordinatesFollowTheirCorners) {
+    // Two triangles over a square; vertex 0 has two texture coordinates (a seam), and a third,
+    // degenerate triangle (repeated vertex) is dropped.
+    const std::string obj =
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+        "vt 0.1 0.1\nvt 0.9 0.1\nvt 0.9 0.9\nvt 0.1 0.9\nvt 0.5 0.5\n"
+        "f 1/1 2/2 3/3\nf 1/1 1/1 2/2\nf 1/5 3/3 4/4\n";
+    Mesh m = loadMesh(writeText("uv.obj", obj));
+    ASSERT_EQ(m.triangles.size(), 2u);
+    ASSERT_EQ(m.uvs.size(), 6u);
+    const glm::vec2 want[6] = {{0.1f, 0.1f}, {0.9f, 0.1f}, {0.9f, 0.9f},
+                               {0.5f, 0.5f}, {0.9f, 0.9f}, {0.1f, 0.9f}};
+    for (int c = 0; c < 6; ++c) {
+        // The corner's vertex decides which UV it has: match by position, not by order.
+        const glm::vec3 p = m.positions[m.triangles[c / 3][c % 3]];
+        const bool first = c < 3;
+        const glm::vec2 expected = p == glm::vec3(0, 0, 0) ? (first ? want[0] : want[3])
+                                   : p == glm::vec3(1, 0, 0) ? want[1]
+                                   : p == glm::vec3(1, 1, 0) ? want[2]
+                                                             : want[5];
+        EXPECT_EQ(m.uvs[c], expected) << "corner " << c;
+    }
+    // PLY vertex u v; the tetrahedron is wound inward, so the loader flips every triangle.
+    const std::string ply =
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+        "property float z\nproperty float u\nproperty float v\nelement face 4\n"
+        "property list uchar int vertex_indices\nend_header\n"
+        "0 0 0 0 0\n1 0 0 1 0\n0 1 0 0 1\n0 0 1 0.5 0.5\n"
+        "3 0 1 2\n3 0 3 1\n3 0 2 3\n3 1 3 2\n";
+    MeshReport report;
+    Mesh t = loadMesh(writeText("uv.ply", ply), &report);
+    ASSERT_EQ(t.uvs.size(), 12u);
+    for (size_t c = 0; c < 12; ++c) {
+        const glm::vec3 p = t.positions[t.triangles[c / 3][c % 3]];
+        const glm::vec2 expected = p.z == 1.0f ? glm::vec2(0.5f) : glm::vec2(p.x, p.y);
+        EXPECT_EQ(t.uvs[c], expected) << "corner " << c;
+    }
+    EXPECT_GT(signedVolume(t), 0.0);
+    // A file without texture coordinates has none.
+    EXPECT_TRUE(loadMesh(writeText("nouv.off", cubeOff())).uvs.empty());
+}
+
 TEST(Mesh, MissingFile) { expectInputError(tmpPath("nope.off"), "file not found"); }
 
 TEST(Mesh, UnsupportedExtension) {

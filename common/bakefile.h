@@ -11,9 +11,19 @@
 
 namespace shrefract {
 
-// 2: per-part and manifest checksums, the layout kind (docs/format.md "Versions"). Readers take
-// version 1 too, unverified.
+// 2: per-part and manifest checksums, the layout kind and the chart layouts (docs/format.md
+// "Versions"). Readers take version 1 too, unverified, as a joining layout.
 constexpr int kFormatVersion = 2;
+
+// How the surface samples are laid out (manifest "layout.kind"):
+//   Joining   paper §5.3: every triangle sampled on a barycentric grid, mu packed, rho with
+//             interpolation correction; continuous across every edge.
+//   Isolated  paper §5.2: the surface cut into charts (CGAL parameterization) and packed into one
+//             atlas with gutters; mu = rho = the atlas, the samples are the covered texel centres.
+//   Uv        the same, with the mesh's own texture coordinates as the charts.
+enum class LayoutKind { Joining, Isolated, Uv };
+const char* ToString(LayoutKind k);                // "joining" | "isolated" | "uv"
+LayoutKind parseLayoutKind(const std::string& text);  // throws InputError
 
 enum class Precision { F32, F16, U8 };
 const char* ToString(Precision p);
@@ -28,10 +38,38 @@ struct RhoTexel {
     uint32_t a = 0, b = 0, c = 0;
 };
 
-// The joining-surfaces layout (paper §5.3): unique samples O_d packed in mu, every triangle as a
-// right triangle of texels in rho, two per block (the second rotated 180 degrees).
+// A gutter texel of a chart layout whose value is taken across the cut (seam-aware gutter
+// filling): sum of weight[k] x D[sample[k]], samples of the chart on the other side of the seam
+// around the point that continues the surface there. Unused slots have weight 0.
+struct SeamSource {
+    uint32_t texel = 0;  // y * atlas width + x
+    uint32_t sample[4] = {0, 0, 0, 0};
+    float weight[4] = {0, 0, 0, 0};
+};
+
+// The charts of an Isolated or Uv layout (paper §5.2): the mesh unfolded into the atlas, vertices
+// split along the seams. The atlas is the mu (= rho) layout; texel (x, y) covers
+// [x, x + 1] x [y, y + 1] in texel units, uv = texel units / (muWidth, muHeight).
+struct ChartAtlas {
+    int gutter = 0;      // texels kept free around every chart when it was packed
+    int chartCount = 0;
+    std::vector<glm::vec3> vertexPosition;  // object space
+    std::vector<glm::vec3> vertexNormal;    // unit shading normal
+    std::vector<glm::vec2> vertexUV;        // atlas coordinates in [0, 1]
+    std::vector<uint32_t> vertexChart;
+    std::vector<glm::uvec3> triangles;      // counter-clockwise seen from outside, as the mesh
+    std::vector<SeamSource> seam;           // seam-aware gutter texels
+    // Not stored (derived from rho on reading): sample i's texel, y * muWidth + x.
+    std::vector<uint32_t> sampleTexel;
+};
+
+// The surface samples O_d and their layouts. Joining (paper §5.3): unique samples packed in mu,
+// every triangle as a right triangle of texels in rho, two per block (the second rotated 180
+// degrees). Isolated and Uv (paper §5.2): mu = rho = the chart atlas (`atlas`), sample i at texel
+// atlas.sampleTexel[i], rho texel kinds Sample (covered, a = the sample) or Empty.
 struct SurfaceLayout {
-    int rate = 1;  // r: grid steps per triangle edge
+    LayoutKind kind = LayoutKind::Joining;
+    int rate = 1;  // r: grid steps per triangle edge (joining; 0 for chart layouts)
     // mu: sample i sits at texel (i % muWidth, i / muWidth); texels past sampleCount are unused.
     int muWidth = 0, muHeight = 0;
     std::vector<glm::vec3> position;  // per sample, object space
@@ -53,7 +91,12 @@ struct SurfaceLayout {
     std::vector<uint32_t> neighbourIndex;
     std::vector<float> neighbourWeight;
 
+    ChartAtlas atlas;  // Isolated and Uv only
+
     int sampleCount() const { return static_cast<int>(position.size()); }
+    bool isChartLayout() const { return kind != LayoutKind::Joining; }
+    // The mu texel of sample i: (i % muWidth, i / muWidth) for joining, its atlas texel for charts.
+    glm::ivec2 muTexel(int i) const;
     // The texel (x, y) in rho of grid sample (i, j) of triangle t (i + j <= r + 1 reaches the
     // correction texels).
     glm::ivec2 rhoTexel(int t, int i, int j) const;

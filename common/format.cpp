@@ -6,6 +6,10 @@
 //   "rho"             rho layout  kind a b c (UINT)
 //   "neighbours"      mu layout   offset count (UINT)
 //   "neighbour_list"  near-square index (UINT), weight (FLOAT); entry e at (e % w, e / w)
+// Chart layouts (isolated, uv) add three near-square lists and put sample i at its atlas texel:
+//   "chart_vertices"  P.x P.y P.z N.x N.y N.z u v (FLOAT), chart (UINT)
+//   "chart_triangles" a b c (UINT)
+//   "seam_sources"    texel s0 s1 s2 s3 (UINT), w0 w1 w2 w3 (FLOAT)
 // The JSON manifest sits in the string attribute "shrefract.manifest" of every part, its XXH3-64
 // in "shrefract.manifestChecksum"; the manifest's "checksums" hold each part's (version 2).
 #include <Iex.h>
@@ -76,6 +80,10 @@ constexpr const char* kSamplesPart = "samples";
 constexpr const char* kRhoPart = "rho";
 constexpr const char* kNeighboursPart = "neighbours";
 constexpr const char* kNeighbourListPart = "neighbour_list";
+constexpr const char* kChartVerticesPart = "chart_vertices";
+constexpr const char* kChartTrianglesPart = "chart_triangles";
+constexpr const char* kSeamSourcesPart = "seam_sources";
+constexpr uint32_t kNoSample = UINT32_MAX;
 // Rows staged per writePixels/readPixels call for the weights part (a ZIP block is 16 lines), so
 // that the weights are never duplicated in memory at full size.
 constexpr int kChunkRows = 16;
@@ -182,6 +190,24 @@ const std::vector<Channel> kRhoChannels = {
     {"kind", Imf::UINT}, {"a", Imf::UINT}, {"b", Imf::UINT}, {"c", Imf::UINT}};
 const std::vector<Channel> kNeighbourChannels = {{"offset", Imf::UINT}, {"count", Imf::UINT}};
 const std::vector<Channel> kNeighbourListChannels = {{"index", Imf::UINT}, {"weight", Imf::FLOAT}};
+const std::vector<Channel> kChartVertexChannels = {
+    {"P.x", Imf::FLOAT}, {"P.y", Imf::FLOAT}, {"P.z", Imf::FLOAT}, {"N.x", Imf::FLOAT},
+    {"N.y", Imf::FLOAT}, {"N.z", Imf::FLOAT}, {"u", Imf::FLOAT},   {"v", Imf::FLOAT},
+    {"chart", Imf::UINT}};
+const std::vector<Channel> kChartTriangleChannels = {
+    {"a", Imf::UINT}, {"b", Imf::UINT}, {"c", Imf::UINT}};
+const std::vector<Channel> kSeamSourceChannels = {
+    {"texel", Imf::UINT}, {"s0", Imf::UINT},  {"s1", Imf::UINT},  {"s2", Imf::UINT},
+    {"s3", Imf::UINT},    {"w0", Imf::FLOAT}, {"w1", Imf::FLOAT}, {"w2", Imf::FLOAT},
+    {"w3", Imf::FLOAT}};
+
+// Which sample each mu texel holds (kNoSample: none), for chart layouts, where sample i sits at
+// its atlas texel; joining layouts address sample i = texel index directly.
+std::vector<uint32_t> texelSamples(const SurfaceLayout& L) {
+    std::vector<uint32_t> map(size_t(L.muWidth) * L.muHeight, kNoSample);
+    for (size_t i = 0; i < L.atlas.sampleTexel.size(); ++i) map[L.atlas.sampleTexel[i]] = uint32_t(i);
+    return map;
+}
 
 // ---------------------------------------------------------------------------------------------
 // 8-bit weights: value = scale * code + offset, per coefficient k and channel c.
@@ -256,6 +282,59 @@ std::string str(const T&... parts) {
     return os.str();
 }
 
+// The chart atlas of an isolated or uv layout: rho is the atlas, every sample shown by exactly
+// one Sample texel, which is its sampleTexel; the unfolded mesh and the seam sources in range.
+std::string chartInconsistency(const SurfaceLayout& L) {
+    const ChartAtlas& A = L.atlas;
+    const size_t N = L.position.size(), texels = size_t(L.muWidth) * L.muHeight;
+    if (L.rhoWidth != L.muWidth || L.rhoHeight != L.muHeight)
+        return str("chart layout with rho ", L.rhoWidth, " x ", L.rhoHeight, " unlike its atlas ",
+                   L.muWidth, " x ", L.muHeight);
+    if (A.sampleTexel.size() != N)
+        return str(A.sampleTexel.size(), " sample texels for ", N, " samples");
+    std::vector<char> seen(N, 0);
+    size_t shown = 0;
+    for (size_t t = 0; t < L.rho.size() && t < texels; ++t) {
+        const RhoTexel& r = L.rho[t];
+        if (r.kind == RhoTexel::Empty) continue;
+        if (r.kind != RhoTexel::Sample || r.a >= N || seen[r.a] || A.sampleTexel[r.a] != t)
+            return str("atlas texel (", t % size_t(L.muWidth), ", ", t / size_t(L.muWidth),
+                       ") is not one sample's own texel (kind ", r.kind, ", sample ", r.a, ")");
+        seen[r.a] = 1;
+        ++shown;
+    }
+    if (shown != N) return str("the atlas shows ", shown, " of ", N, " samples");
+    const size_t V = A.vertexPosition.size();
+    if (A.vertexNormal.size() != V || A.vertexUV.size() != V || A.vertexChart.size() != V)
+        return str("chart vertex arrays differ in size: ", V, " positions, ", A.vertexNormal.size(),
+                   " normals, ", A.vertexUV.size(), " uvs, ", A.vertexChart.size(), " charts");
+    if (A.gutter < 0) return str("gutter ", A.gutter, " is negative");
+    if (size_t(L.triangleCount) != A.triangles.size())
+        return str("triangle count ", L.triangleCount, " but ", A.triangles.size(), " chart triangles");
+    if (A.chartCount < 1) return str(A.chartCount, " charts");
+    for (size_t v = 0; v < V; ++v) {
+        const glm::vec2 uv = A.vertexUV[v];
+        if (!(uv.x >= 0.0f && uv.x <= 1.0f && uv.y >= 0.0f && uv.y <= 1.0f))
+            return str("chart vertex ", v, " has uv (", uv.x, ", ", uv.y, ") outside [0, 1]");
+        if (A.vertexChart[v] >= uint32_t(A.chartCount))
+            return str("chart vertex ", v, " is in chart ", A.vertexChart[v], " of ", A.chartCount);
+    }
+    for (size_t t = 0; t < A.triangles.size(); ++t)
+        for (int k = 0; k < 3; ++k)
+            if (A.triangles[t][k] >= V)
+                return str("chart triangle ", t, " refers to vertex ", A.triangles[t][k],
+                           " but there are only ", V);
+    for (size_t e = 0; e < A.seam.size(); ++e) {
+        const SeamSource& s = A.seam[e];
+        if (s.texel >= texels) return str("seam source ", e, " fills texel ", s.texel, " outside the atlas");
+        for (int k = 0; k < 4; ++k)
+            if (s.weight[k] != 0.0f && (s.sample[k] >= N || !std::isfinite(s.weight[k])))
+                return str("seam source ", e, " takes sample ", s.sample[k], " with weight ",
+                           s.weight[k], " (", N, " samples)");
+    }
+    return "";
+}
+
 std::string inconsistency(const BakeData& d) {
     const SurfaceLayout& L = d.layout;
     if (d.order < 0) return str("order ", d.order, " is negative");
@@ -272,9 +351,14 @@ std::string inconsistency(const BakeData& d) {
         return str("rho layout is ", L.rhoWidth, " x ", L.rhoHeight, " texels");
     if (L.rho.size() != size_t(L.rhoWidth) * size_t(L.rhoHeight))
         return str("rho has ", L.rho.size(), " texels, expected ", L.rhoWidth, " x ", L.rhoHeight);
-    if (L.rate < 1) return str("rate ", L.rate, " is below 1");
+    if (L.isChartLayout()) {
+        const std::string chart = chartInconsistency(L);
+        if (!chart.empty()) return chart;
+    } else if (L.rate < 1) {
+        return str("rate ", L.rate, " is below 1");
+    }
     if (L.triangleCount < 0) return str("triangle count ", L.triangleCount, " is negative");
-    if (L.triangleCount > 0) {
+    if (L.triangleCount > 0 && !L.isChartLayout()) {
         if (L.blockWidth < 1 || L.blockHeight < 1 || L.blocksPerRow < 1)
             return str("rho blocks are ", L.blockWidth, " x ", L.blockHeight, ", ", L.blocksPerRow,
                        " per row");
@@ -353,15 +437,24 @@ void writeWhole(Imf::MultiPartOutputFile& file, int part, Planes& planes, int he
     out.writePixels(height);
 }
 
-// Rows y0 .. y0 + rows - 1 of the weights part, quantized to the bake's precision.
-Planes weightChunk(const BakeData& d, const U8Params& u8, int y0, int rows) {
+// The sample at mu texel `texel` (kNoSample: none): `map` for chart layouts (texelSamples), else
+// the texel index itself while below the sample count.
+uint32_t sampleOfTexel(const std::vector<uint32_t>& map, size_t texel, size_t N) {
+    if (!map.empty()) return map[texel];
+    return texel < N ? uint32_t(texel) : kNoSample;
+}
+
+// Rows y0 .. y0 + rows - 1 of the weights part, quantized to the bake's precision. `map`: the
+// chart layout's texelSamples, empty for joining.
+Planes weightChunk(const BakeData& d, const U8Params& u8, const std::vector<uint32_t>& map,
+                   int y0, int rows) {
     const SurfaceLayout& L = d.layout;
     const int K = d.coefficientCount();
     const size_t N = L.position.size();
     Planes chunk(L.muWidth, rows, weightChannels(K, d.precision));
     for (size_t t = 0; t < size_t(L.muWidth) * rows; ++t) {
-        const size_t i = size_t(y0) * L.muWidth + t;
-        if (i >= N) break;  // texels past the last sample stay zero
+        const uint32_t i = sampleOfTexel(map, size_t(y0) * L.muWidth + t, N);
+        if (i == kNoSample) continue;  // texels without a sample stay zero
         for (int k = 0; k < K; ++k) {
             const float* w = &d.weights[(size_t(k) * N + i) * 4];
             if (d.precision == Precision::U8) {
@@ -387,20 +480,22 @@ Planes weightChunk(const BakeData& d, const U8Params& u8, int y0, int rows) {
 }
 
 // The checksum of the whole weights part, chunk by chunk as it will be written.
-std::string weightsChecksum(const BakeData& d, const U8Params& u8) {
+std::string weightsChecksum(const BakeData& d, const U8Params& u8, const std::vector<uint32_t>& map) {
     Checksum sum;
     for (int y0 = 0; y0 < d.layout.muHeight; y0 += kChunkRows) {
-        const Planes chunk = weightChunk(d, u8, y0, std::min(kChunkRows, d.layout.muHeight - y0));
+        const Planes chunk =
+            weightChunk(d, u8, map, y0, std::min(kChunkRows, d.layout.muHeight - y0));
         sum.update(chunk.bytes().data(), chunk.bytes().size());
     }
     return sum.hex();
 }
 
-void writeWeights(Imf::MultiPartOutputFile& file, int part, const BakeData& d, const U8Params& u8) {
+void writeWeights(Imf::MultiPartOutputFile& file, int part, const BakeData& d, const U8Params& u8,
+                  const std::vector<uint32_t>& map) {
     Imf::OutputPart out(file, part);
     for (int y0 = 0; y0 < d.layout.muHeight; y0 += kChunkRows) {
         const int rows = std::min(kChunkRows, d.layout.muHeight - y0);
-        Planes chunk = weightChunk(d, u8, y0, rows);
+        Planes chunk = weightChunk(d, u8, map, y0, rows);
         out.setFrameBuffer(chunk.frameBuffer(y0));
         out.writePixels(rows);
     }
@@ -520,6 +615,53 @@ std::string manifestText(Imf::MultiPartInputFile& file, int version, bool verify
     return text->value();
 }
 
+// The unfolded mesh and the seam sources of a chart layout (sizes from the manifest's "layout").
+template <class Find>
+void readChartParts(Imf::MultiPartInputFile& file, Find find, const json& layout,
+                    const Verifier& verifier, ChartAtlas& A) {
+    auto count = [&](const char* key) {
+        auto it = layout.find(key);
+        if (it == layout.end() || !it->is_number_integer() || it->get<int64_t>() < 0 ||
+            it->get<int64_t>() > (int64_t(1) << 31))
+            throw InputError(str("manifest \"layout\" has no count \"", key, "\""));
+        return size_t(it->get<int64_t>());
+    };
+    A.gutter = int(count("gutter"));
+    A.chartCount = int(count("charts"));
+    auto read = [&](const char* name, const std::vector<Channel>& ch, size_t n) {
+        const int p = find(name);
+        const auto [w, h] = neighbourListSize(n);
+        checkPart(file.header(p), name, w, h, ch);
+        Planes planes(w, h, ch);
+        readWhole(file, p, planes, h, verifier, name);
+        return planes;
+    };
+    const size_t V = count("vertices"), T = count("triangles"), S = count("seamSources");
+    const Planes v = read(kChartVerticesPart, kChartVertexChannels, V);
+    A.vertexPosition.resize(V);
+    A.vertexNormal.resize(V);
+    A.vertexUV.resize(V);
+    A.vertexChart.resize(V);
+    for (size_t i = 0; i < V; ++i) {
+        A.vertexPosition[i] = {v.f(i, 0), v.f(i, 1), v.f(i, 2)};
+        A.vertexNormal[i] = {v.f(i, 3), v.f(i, 4), v.f(i, 5)};
+        A.vertexUV[i] = {v.f(i, 6), v.f(i, 7)};
+        A.vertexChart[i] = v.u(i, 8);
+    }
+    const Planes t = read(kChartTrianglesPart, kChartTriangleChannels, T);
+    A.triangles.resize(T);
+    for (size_t i = 0; i < T; ++i) A.triangles[i] = {t.u(i, 0), t.u(i, 1), t.u(i, 2)};
+    const Planes g = read(kSeamSourcesPart, kSeamSourceChannels, S);
+    A.seam.resize(S);
+    for (size_t i = 0; i < S; ++i) {
+        A.seam[i].texel = g.u(i, 0);
+        for (int k = 0; k < 4; ++k) {
+            A.seam[i].sample[k] = g.u(i, 1 + k);
+            A.seam[i].weight[k] = g.f(i, 5 + k);
+        }
+    }
+}
+
 BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
     // The manifest of the first part is the one that counts. Its version decides how it is
     // verified, so it is parsed once unverified, then taken again through its checksum.
@@ -542,15 +684,22 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
                                " carries no checksums: its data cannot be verified (re-bake to get "
                                "version ", kFormatVersion, ")"));
     const Verifier verifier(m, options.verify && version >= 2);
-    if (version >= 2) {
+    BakeData d;
+    SurfaceLayout& L = d.layout;
+    json layoutInfo = json::object();
+    if (version >= 2) {  // version 1 files are all joining layouts
         auto layout = m.find("layout");
-        if (layout == m.end() || !layout->is_object() || !layout->contains("kind"))
+        if (layout == m.end() || !layout->is_object() || !layout->contains("kind") ||
+            !(*layout)["kind"].is_string())
             throw InputError("manifest has no \"layout\" kind");
-        if ((*layout)["kind"] != "joining")
+        try {
+            L.kind = parseLayoutKind((*layout)["kind"].get<std::string>());
+        } catch (const InputError&) {
             throw InputError(str("unknown layout kind ", (*layout)["kind"].dump()));
+        }
+        layoutInfo = *layout;
     }
 
-    BakeData d;
     d.order = manifestInt(m, "order");
     if (d.order < 0 || d.order > 100) throw InputError(str("SH order ", d.order, " is absurd"));
     const int K = d.coefficientCount();
@@ -561,7 +710,6 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
         throw InputError("manifest has no \"precision\"");
     d.precision = parsePrecision(m["precision"].get<std::string>());
 
-    SurfaceLayout& L = d.layout;
     const int N = manifestInt(m, "sampleCount");
     const std::vector<int> mu = manifestInts(m, "mu", 2), rho = manifestInts(m, "rho", 2),
                            block = manifestInts(m, "block", 3);
@@ -611,13 +759,41 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
         throw InputError(str("neighbour list of ", nlLength, " entries does not fit its ", nlWidth,
                              " x ", nlHeight, " part"));
 
+    // rho first: in a chart layout it says where each sample sits in the mu parts.
+    Planes rhoPlanes(L.rhoWidth, L.rhoHeight, kRhoChannels);
+    readWhole(file, pRho, rhoPlanes, L.rhoHeight, verifier, kRhoPart);
+    L.rho.resize(size_t(L.rhoWidth) * L.rhoHeight);
+    for (size_t t = 0; t < L.rho.size(); ++t)
+        L.rho[t] = {rhoPlanes.u(t, 0), rhoPlanes.u(t, 1), rhoPlanes.u(t, 2), rhoPlanes.u(t, 3)};
+    std::vector<uint32_t> texelMap;  // chart layouts: the sample at each mu texel
+    if (L.isChartLayout()) {
+        if (L.rhoWidth != L.muWidth || L.rhoHeight != L.muHeight)
+            throw InputError(str("inconsistent bake: chart layout with rho ", L.rhoWidth, " x ",
+                                 L.rhoHeight, " unlike its atlas ", L.muWidth, " x ", L.muHeight));
+        texelMap.assign(L.rho.size(), kNoSample);
+        L.atlas.sampleTexel.assign(size_t(N), kNoSample);
+        for (size_t t = 0; t < L.rho.size(); ++t) {
+            const RhoTexel& r = L.rho[t];
+            if (r.kind == RhoTexel::Empty) continue;
+            if (r.kind != RhoTexel::Sample || r.a >= uint32_t(N) || L.atlas.sampleTexel[r.a] != kNoSample)
+                throw InputError(str("inconsistent bake: atlas texel (", t % size_t(L.muWidth), ", ",
+                                     t / size_t(L.muWidth), ") is not one sample's own texel"));
+            texelMap[t] = r.a;
+            L.atlas.sampleTexel[r.a] = uint32_t(t);
+        }
+        for (int i = 0; i < N; ++i)
+            if (L.atlas.sampleTexel[i] == kNoSample)
+                throw InputError(str("inconsistent bake: sample ", i, " has no atlas texel"));
+    }
+
     // Weights, a band of rows at a time, dequantized to float. Verified, every row is read (the
     // checksum covers the padding past the last sample too).
     d.weights.assign(size_t(K) * N * 4, 0.0f);
     {
         Imf::InputPart in(file, pWeights);
         Checksum sum;
-        for (int y0 = 0; y0 < L.muHeight && (verifier.on() || int64_t(y0) * L.muWidth < N);
+        for (int y0 = 0; y0 < L.muHeight && (verifier.on() || L.isChartLayout() ||
+                                             int64_t(y0) * L.muWidth < N);
              y0 += kChunkRows) {
             const int rows = std::min(kChunkRows, L.muHeight - y0);
             Planes chunk(L.muWidth, rows, wChannels);
@@ -625,8 +801,8 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
             in.readPixels(y0, y0 + rows - 1);
             sum.update(chunk.bytes().data(), chunk.bytes().size());
             for (size_t t = 0; t < size_t(L.muWidth) * rows; ++t) {
-                const size_t i = size_t(y0) * L.muWidth + t;
-                if (i >= size_t(N)) break;
+                const uint32_t i = sampleOfTexel(texelMap, size_t(y0) * L.muWidth + t, size_t(N));
+                if (i == kNoSample) continue;
                 for (int k = 0; k < K; ++k) {
                     float* w = &d.weights[(size_t(k) * N + i) * 4];
                     if (d.precision == Precision::U8) {
@@ -655,18 +831,13 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
     L.neighbourOffset.resize(N);
     L.neighbourCount.resize(N);
     for (int i = 0; i < N; ++i) {
-        L.position[i] = {samples.f(i, 0), samples.f(i, 1), samples.f(i, 2)};
-        L.normal[i] = {samples.f(i, 3), samples.f(i, 4), samples.f(i, 5)};
-        L.part[i] = samples.u(i, 6);
-        L.neighbourOffset[i] = neighbours.u(i, 0);
-        L.neighbourCount[i] = neighbours.u(i, 1);
+        const size_t t = L.isChartLayout() ? size_t(L.atlas.sampleTexel[i]) : size_t(i);
+        L.position[i] = {samples.f(t, 0), samples.f(t, 1), samples.f(t, 2)};
+        L.normal[i] = {samples.f(t, 3), samples.f(t, 4), samples.f(t, 5)};
+        L.part[i] = samples.u(t, 6);
+        L.neighbourOffset[i] = neighbours.u(t, 0);
+        L.neighbourCount[i] = neighbours.u(t, 1);
     }
-
-    Planes rhoPlanes(L.rhoWidth, L.rhoHeight, kRhoChannels);
-    readWhole(file, pRho, rhoPlanes, L.rhoHeight, verifier, kRhoPart);
-    L.rho.resize(size_t(L.rhoWidth) * L.rhoHeight);
-    for (size_t t = 0; t < L.rho.size(); ++t)
-        L.rho[t] = {rhoPlanes.u(t, 0), rhoPlanes.u(t, 1), rhoPlanes.u(t, 2), rhoPlanes.u(t, 3)};
 
     Planes list(nlWidth, nlHeight, kNeighbourListChannels);
     readWhole(file, pList, list, nlHeight, verifier, kNeighbourListPart);
@@ -676,6 +847,7 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
         L.neighbourIndex[e] = list.u(e, 0);
         L.neighbourWeight[e] = list.f(e, 1);
     }
+    if (L.isChartLayout()) readChartParts(file, find, layoutInfo, verifier, L.atlas);
 
     const std::string problem = inconsistency(d);
     if (!problem.empty()) throw InputError("inconsistent bake: " + problem);
@@ -701,14 +873,17 @@ void writeBake(const std::string& path, const BakeData& data) {
     Planes samples(L.muWidth, L.muHeight, kSampleChannels);
     Planes neighbours(L.muWidth, L.muHeight, kNeighbourChannels);
     for (int i = 0; i < L.sampleCount(); ++i) {
+        const glm::ivec2 x = L.muTexel(i);
+        const size_t t = size_t(x.y) * L.muWidth + x.x;
         for (int c = 0; c < 3; ++c) {
-            samples.setF(i, c, L.position[i][c]);
-            samples.setF(i, 3 + c, L.normal[i][c]);
+            samples.setF(t, c, L.position[i][c]);
+            samples.setF(t, 3 + c, L.normal[i][c]);
         }
-        samples.setU(i, 6, L.part[i]);
-        neighbours.setU(i, 0, L.neighbourOffset[i]);
-        neighbours.setU(i, 1, L.neighbourCount[i]);
+        samples.setU(t, 6, L.part[i]);
+        neighbours.setU(t, 0, L.neighbourOffset[i]);
+        neighbours.setU(t, 1, L.neighbourCount[i]);
     }
+    const std::vector<uint32_t> texelMap = L.isChartLayout() ? texelSamples(L) : std::vector<uint32_t>{};
     Planes rho(L.rhoWidth, L.rhoHeight, kRhoChannels);
     for (size_t t = 0; t < L.rho.size(); ++t) {
         rho.setU(t, 0, L.rho[t].kind);
@@ -722,6 +897,44 @@ void writeBake(const std::string& path, const BakeData& data) {
         list.setF(e, 1, L.neighbourWeight[e]);
     }
     auto sum = [](const Planes& p) { return checksumHex(p.bytes().data(), p.bytes().size()); };
+
+    // Chart layouts: the unfolded mesh and the seam sources, as near-square lists.
+    struct ListPart {
+        const char* name;
+        std::vector<Channel> channels;
+        int width, height;
+        Planes planes;
+    };
+    std::vector<ListPart> chartParts;
+    if (L.isChartLayout()) {
+        const ChartAtlas& A = L.atlas;
+        auto add = [&](const char* name, const std::vector<Channel>& ch, size_t n) -> Planes& {
+            const auto [w, h] = neighbourListSize(n);
+            chartParts.push_back({name, ch, w, h, Planes(w, h, ch)});
+            return chartParts.back().planes;
+        };
+        Planes& v = add(kChartVerticesPart, kChartVertexChannels, A.vertexPosition.size());
+        for (size_t i = 0; i < A.vertexPosition.size(); ++i) {
+            for (int c = 0; c < 3; ++c) {
+                v.setF(i, c, A.vertexPosition[i][c]);
+                v.setF(i, 3 + c, A.vertexNormal[i][c]);
+            }
+            v.setF(i, 6, A.vertexUV[i].x);
+            v.setF(i, 7, A.vertexUV[i].y);
+            v.setU(i, 8, A.vertexChart[i]);
+        }
+        Planes& t = add(kChartTrianglesPart, kChartTriangleChannels, A.triangles.size());
+        for (size_t i = 0; i < A.triangles.size(); ++i)
+            for (int c = 0; c < 3; ++c) t.setU(i, c, A.triangles[i][c]);
+        Planes& g = add(kSeamSourcesPart, kSeamSourceChannels, A.seam.size());
+        for (size_t i = 0; i < A.seam.size(); ++i) {
+            g.setU(i, 0, A.seam[i].texel);
+            for (int k = 0; k < 4; ++k) {
+                g.setU(i, 1 + k, A.seam[i].sample[k]);
+                g.setF(i, 5 + k, A.seam[i].weight[k]);
+            }
+        }
+    }
 
     json m = data.manifest.is_null() ? json::object() : data.manifest;
     m["format"] = "shrefract";
@@ -737,18 +950,32 @@ void writeBake(const std::string& path, const BakeData& data) {
     m["rate"] = L.rate;
     m["neighbourListWidth"] = nlWidth;
     m["neighbourListLength"] = L.neighbourIndex.size();
-    m["layout"] = {{"kind", "joining"}};
+    // "layout": the kind and, for charts, the part sizes are the writer's; other keys the bake
+    // tool put there stay (descriptive).
+    json layout = m.contains("layout") && m["layout"].is_object() ? m["layout"] : json::object();
+    layout["kind"] = ToString(L.kind);
+    for (const char* key : {"gutter", "charts", "vertices", "triangles", "seamSources"}) layout.erase(key);
+    if (L.isChartLayout()) {
+        const ChartAtlas& A = L.atlas;
+        layout["gutter"] = A.gutter;
+        layout["charts"] = A.chartCount;
+        layout["vertices"] = A.vertexPosition.size();
+        layout["triangles"] = A.triangles.size();
+        layout["seamSources"] = A.seam.size();
+    }
+    m["layout"] = layout;
     if (data.precision == Precision::U8)
         m["u8"] = {{"scale", u8.scale}, {"offset", u8.offset}};
     else
         m.erase("u8");
     m["checksums"] = {{"algorithm", kChecksumAlgorithm},
                       {"parts",
-                       {{kWeightsPart, weightsChecksum(data, u8)},
+                       {{kWeightsPart, weightsChecksum(data, u8, texelMap)},
                         {kSamplesPart, sum(samples)},
                         {kRhoPart, sum(rho)},
                         {kNeighboursPart, sum(neighbours)},
                         {kNeighbourListPart, sum(list)}}}};
+    for (const ListPart& p : chartParts) m["checksums"]["parts"][p.name] = sum(p.planes);
     std::string text;
     try {
         text = m.dump();
@@ -768,6 +995,10 @@ void writeBake(const std::string& path, const BakeData& data) {
     addChannels(headers[2], kRhoChannels);
     addChannels(headers[3], kNeighbourChannels);
     addChannels(headers[4], kNeighbourListChannels);
+    for (const ListPart& p : chartParts) {
+        headers.push_back(partHeader(p.name, p.width, p.height, display, text));
+        addChannels(headers.back(), p.channels);
+    }
 
     const std::string tmp = path + ".tmp." + std::to_string(::getpid());
     try {
@@ -776,11 +1007,13 @@ void writeBake(const std::string& path, const BakeData& data) {
         {
             Imf::StdOFStream stream(os, tmp.c_str());
             Imf::MultiPartOutputFile file(stream, headers.data(), int(headers.size()));
-            writeWeights(file, 0, data, u8);
+            writeWeights(file, 0, data, u8, texelMap);
             writeWhole(file, 1, samples, L.muHeight);
             writeWhole(file, 2, rho, L.rhoHeight);
             writeWhole(file, 3, neighbours, L.muHeight);
             writeWhole(file, 4, list, nlHeight);
+            for (size_t p = 0; p < chartParts.size(); ++p)
+                writeWhole(file, int(5 + p), chartParts[p].planes, chartParts[p].height);
         }  // the destructor writes the chunk offset tables; it swallows errors, the stream not
         os.flush();
         os.close();

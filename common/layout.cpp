@@ -1,9 +1,35 @@
-// Addressing in the joining-surfaces layout (declared in common/bakefile.h). The layout itself
-// is built by the bake (bake/layout.cpp); these are the lookups everyone shares.
+// Addressing in the surface layouts (declared in common/bakefile.h). The layouts themselves are
+// built by the bake (bake/layout.cpp, bake/charts.cpp); these are the lookups everyone shares.
 #include "common/bakefile.h"
 #include "common/error.h"
 
 namespace shrefract {
+
+const char* ToString(LayoutKind k) {
+    switch (k) {
+        case LayoutKind::Joining:
+            return "joining";
+        case LayoutKind::Isolated:
+            return "isolated";
+        case LayoutKind::Uv:
+            return "uv";
+    }
+    return "unknown";
+}
+
+LayoutKind parseLayoutKind(const std::string& text) {
+    if (text == "joining") return LayoutKind::Joining;
+    if (text == "isolated") return LayoutKind::Isolated;
+    if (text == "uv") return LayoutKind::Uv;
+    throw InputError("unknown layout kind \"" + text + "\" (expected joining, isolated or uv)");
+}
+
+glm::ivec2 SurfaceLayout::muTexel(int i) const {
+    if (!isChartLayout()) return {i % muWidth, i / muWidth};
+    const uint32_t t = atlas.sampleTexel[static_cast<size_t>(i)];
+    return {static_cast<int>(t % static_cast<uint32_t>(muWidth)),
+            static_cast<int>(t / static_cast<uint32_t>(muWidth))};
+}
 
 glm::ivec2 SurfaceLayout::rhoTexel(int t, int i, int j) const {
     int b = t / 2;

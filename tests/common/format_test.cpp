@@ -21,6 +21,7 @@
 #include <map>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "common/bakefile.h"
@@ -118,7 +119,76 @@ BakeData syntheticBake(Precision precision, uint32_t seed = 7) {
     return d;
 }
 
+// A chart layout (isolated): a 6 x 5 atlas with two charts, 9 samples at scattered texels (not in
+// texel order: sample i is not texel i), 5 vertices, 3 triangles, two seam sources.
+BakeData syntheticChartBake(Precision precision, uint32_t seed = 5) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f), length(0.0f, 3.0f);
+    BakeData d;
+    d.order = 2;
+    d.precision = precision;
+    SurfaceLayout& L = d.layout;
+    L.kind = LayoutKind::Isolated;
+    L.rate = 0;
+    L.muWidth = L.rhoWidth = 6;
+    L.muHeight = L.rhoHeight = 5;
+    L.rho.assign(30, RhoTexel{});
+    const uint32_t texel[9] = {7, 8, 13, 14, 2, 27, 21, 22, 28};
+    for (uint32_t i = 0; i < 9; ++i) {
+        L.position.push_back({unit(rng), unit(rng), unit(rng)});
+        L.normal.push_back(glm::normalize(glm::vec3(unit(rng), unit(rng), 1.5f)));
+        L.part.push_back(0);
+        L.atlas.sampleTexel.push_back(texel[i]);
+        L.rho[texel[i]] = RhoTexel{RhoTexel::Sample, i, 0, 0};
+    }
+    L.neighbourOffset.assign(9, 0);
+    L.neighbourCount.assign(9, 0);
+    ChartAtlas& A = L.atlas;
+    A.gutter = 1;
+    A.chartCount = 2;
+    for (int v = 0; v < 5; ++v) {
+        A.vertexPosition.push_back({unit(rng), unit(rng), unit(rng)});
+        A.vertexNormal.push_back(glm::normalize(glm::vec3(unit(rng), 0.5f, 1.0f)));
+        A.vertexUV.push_back({0.1f + 0.2f * v, 0.9f - 0.15f * v});
+        A.vertexChart.push_back(v < 3 ? 0 : 1);
+    }
+    A.triangles = {{0, 1, 2}, {2, 1, 3}, {3, 4, 2}};
+    L.triangleCount = 3;
+    SeamSource a;
+    a.texel = 1;
+    a.sample[0] = 4, a.sample[1] = 2, a.weight[0] = 0.75f, a.weight[1] = 0.25f;
+    SeamSource b;
+    b.texel = 29;
+    b.sample[0] = 8, b.weight[0] = 1.0f;
+    A.seam = {a, b};
+    const int K = d.coefficientCount();
+    d.weights.resize(size_t(K) * 9 * 4);
+    for (size_t v = 0; v < d.weights.size(); ++v) d.weights[v] = v % 4 == 3 ? length(rng) : unit(rng);
+    d.manifest = {{"layout", {{"kind", "stale"}, {"method", "lscm"}}}};
+    return d;
+}
+
+void expectAtlasEqual(const ChartAtlas& a, const ChartAtlas& b) {
+    EXPECT_EQ(a.gutter, b.gutter);
+    EXPECT_EQ(a.chartCount, b.chartCount);
+    EXPECT_EQ(a.vertexPosition, b.vertexPosition);
+    EXPECT_EQ(a.vertexNormal, b.vertexNormal);
+    EXPECT_EQ(a.vertexUV, b.vertexUV);
+    EXPECT_EQ(a.vertexChart, b.vertexChart);
+    EXPECT_EQ(a.triangles, b.triangles);
+    EXPECT_EQ(a.sampleTexel, b.sampleTexel);
+    ASSERT_EQ(a.seam.size(), b.seam.size());
+    for (size_t e = 0; e < a.seam.size(); ++e) {
+        EXPECT_EQ(a.seam[e].texel, b.seam[e].texel) << e;
+        for (int k = 0; k < 4; ++k) {
+            EXPECT_EQ(a.seam[e].sample[k], b.seam[e].sample[k]) << e;
+            EXPECT_EQ(a.seam[e].weight[k], b.seam[e].weight[k]) << e;
+        }
+    }
+}
+
 void expectLayoutEqual(const SurfaceLayout& a, const SurfaceLayout& b) {
+    EXPECT_EQ(a.kind, b.kind);
     EXPECT_EQ(a.rate, b.rate);
     EXPECT_EQ(a.muWidth, b.muWidth);
     EXPECT_EQ(a.muHeight, b.muHeight);
@@ -154,6 +224,9 @@ std::vector<std::string> documentedChannels(const std::string& part, const Imf::
     if (part == "rho") return {"kind", "a", "b", "c"};
     if (part == "neighbours") return {"offset", "count"};
     if (part == "neighbour_list") return {"index", "weight"};
+    if (part == "chart_vertices") return {"P.x", "P.y", "P.z", "N.x", "N.y", "N.z", "u", "v", "chart"};
+    if (part == "chart_triangles") return {"a", "b", "c"};
+    if (part == "seam_sources") return {"texel", "s0", "s1", "s2", "s3", "w0", "w1", "w2", "w3"};
     std::vector<std::string> names;  // weights: w000.x, w000.y, w000.z, w000.len, w001.x, ...
     for (int k = 0;; ++k) {
         char base[16];
@@ -397,6 +470,100 @@ TEST(Format, LayoutArraysSurviveRoundTrip) {
     }
 }
 
+// Chart layouts: the atlas, the unfolded mesh and the seam sources come back as written, every
+// sample from its own atlas texel, at every precision.
+TEST(Format, ChartLayoutRoundTrips) {
+    const fs::path dir = scratch();
+    for (Precision p : {Precision::F32, Precision::F16, Precision::U8}) {
+        SCOPED_TRACE(ToString(p));
+        const fs::path path = dir / (std::string(ToString(p)) + ".shrefract.exr");
+        const BakeData d = syntheticChartBake(p);
+        writeBake(path.string(), d);
+        const BakeData r = readBake(path.string());
+        expectLayoutEqual(r.layout, d.layout);
+        expectAtlasEqual(r.layout.atlas, d.layout.atlas);
+        EXPECT_EQ(r.manifest.at("layout").at("kind"), "isolated");  // the stale kind is replaced
+        EXPECT_EQ(r.manifest.at("layout").at("method"), "lscm");    // descriptive keys stay
+        EXPECT_EQ(r.manifest.at("layout").at("charts"), 2);
+        if (p == Precision::F32) EXPECT_EQ(r.weights, d.weights);
+    }
+}
+
+// What a third party reads with OpenEXR alone (docs/format.md): in a chart layout sample i's
+// weights and position sit at the texel where rho shows sample i, not at texel i.
+TEST(Format, ChartSamplesSitAtTheirAtlasTexels) {
+    const fs::path path = scratch() / "chart.shrefract.exr";
+    const BakeData d = syntheticChartBake(Precision::F32);
+    writeBake(path.string(), d);
+    Imf::MultiPartInputFile file(path.c_str());
+    std::map<std::string, int> part;
+    for (int p = 0; p < file.parts(); ++p) part[file.header(p).name()] = p;
+    for (const char* name : {"chart_vertices", "chart_triangles", "seam_sources"})
+        EXPECT_TRUE(part.count(name)) << name;
+    auto readChannel = [&](const char* name, const char* channel, Imf::PixelType type) {
+        std::vector<uint32_t> bytes(30);
+        Imf::InputPart in(file, part.at(name));
+        Imf::FrameBuffer fb;
+        fb.insert(channel, Imf::Slice(type, reinterpret_cast<char*>(bytes.data()), 4, 4 * 6));
+        in.setFrameBuffer(fb);
+        in.readPixels(0, 4);
+        return bytes;
+    };
+    const std::vector<uint32_t> kind = readChannel("rho", "kind", Imf::UINT);
+    const std::vector<uint32_t> a = readChannel("rho", "a", Imf::UINT);
+    const std::vector<uint32_t> w = readChannel("weights", "w001.z", Imf::FLOAT);
+    const std::vector<uint32_t> px = readChannel("samples", "P.x", Imf::FLOAT);
+    int shown = 0;
+    for (int t = 0; t < 30; ++t) {
+        if (kind[t] == 0) {
+            float zero;
+            std::memcpy(&zero, &w[t], 4);
+            EXPECT_EQ(zero, 0.0f) << "texel " << t;
+            continue;
+        }
+        ++shown;
+        const uint32_t i = a[t];
+        float wv, pv;
+        std::memcpy(&wv, &w[t], 4);
+        std::memcpy(&pv, &px[t], 4);
+        EXPECT_EQ(wv, d.weights[(size_t(1) * 9 + i) * 4 + 2]) << "texel " << t;
+        EXPECT_EQ(pv, d.layout.position[i].x) << "texel " << t;
+    }
+    EXPECT_EQ(shown, 9);
+}
+
+// Valid checksums, wrong content: each is refused with what is wrong.
+TEST(Format, InconsistentChartLayoutsAreReported) {
+    const fs::path dir = scratch();
+    const fs::path ok = dir / "ok.shrefract.exr";
+    writeBake(ok.string(), syntheticChartBake(Precision::F32));
+    rewrite(ok, dir / "kind.shrefract.exr", [](json& m) { m["layout"]["kind"] = "spiral"; });
+    expectInputError(dir / "kind.shrefract.exr", "unknown layout kind \"spiral\"");
+    // rho shows sample 3 twice (texel 0 copies texel 14's index).
+    rewrite(ok, dir / "twice.shrefract.exr", [](json&) {},
+            [](const std::string& p, const std::string& c, std::vector<char>& bytes) {
+                if (p == "rho" && (c == "kind" || c == "a")) std::memcpy(&bytes[0], &bytes[4 * 14], 4);
+            });
+    expectInputError(dir / "twice.shrefract.exr", "is not one sample's own texel");
+    // A triangle pointing past the vertices; a seam source taking a sample that does not exist.
+    const std::tuple<const char*, const char*, uint32_t, const char*> edits[] = {
+        {"chart_triangles", "c", 99, "refers to vertex 99"}, {"seam_sources", "s0", 9, "takes sample 9"}};
+    for (const auto& [part, channel, value, what] : edits) {
+        const fs::path bad = dir / (std::string(part) + ".shrefract.exr");
+        rewrite(ok, bad, [](json&) {},
+                [&, part = part, channel = channel, value = value](
+                    const std::string& p, const std::string& c, std::vector<char>& bytes) {
+                    if (p == part && c == channel) std::memcpy(&bytes[0], &value, 4);
+                });
+        expectInputError(bad, what);
+    }
+    // The writer refuses the same kind of thing before it opens a file.
+    BakeData d = syntheticChartBake(Precision::F32);
+    d.layout.atlas.vertexUV[2].x = 1.5f;
+    EXPECT_THROW(writeBake((dir / "uv.shrefract.exr").string(), d), std::invalid_argument);
+    EXPECT_FALSE(fs::exists(dir / "uv.shrefract.exr"));
+}
+
 TEST(Format, EmptyNeighbourListRoundTrips) {
     const fs::path path = scratch() / "noneighbours.shrefract.exr";
     BakeData d = syntheticBake(Precision::F32);
@@ -626,15 +793,18 @@ bool sameData(const BakeData& a, const BakeData& b) {
 // verification off the same file loads (so it is the checksum that refuses it).
 TEST(Format, EveryPartIsCheckedAgainstItsChecksum) {
     const fs::path dir = scratch();
-    const fs::path ok = dir / "ok.shrefract.exr";
+    const fs::path ok = dir / "ok.shrefract.exr", okCharts = dir / "charts.shrefract.exr";
     writeBake(ok.string(), syntheticBake(Precision::F16));
+    writeBake(okCharts.string(), syntheticChartBake(Precision::F32));
     const std::pair<const char*, const char*> targets[] = {
-        {"weights", "w003.y"}, {"samples", "N.x"}, {"rho", "kind"},
-        {"neighbours", "count"}, {"neighbour_list", "weight"}};
+        {"weights", "w003.y"},   {"samples", "N.x"},         {"rho", "kind"},
+        {"neighbours", "count"}, {"neighbour_list", "weight"}, {"chart_vertices", "u"},
+        {"chart_triangles", "b"}, {"seam_sources", "w0"}};
     for (const auto& [part, channel] : targets) {
         const fs::path bad = dir / (std::string(part) + ".shrefract.exr");
+        const bool chartPart = std::string(part).rfind("chart_", 0) == 0 || std::string(part) == "seam_sources";
         rewrite(
-            ok, bad, [](json&) {},
+            chartPart ? okCharts : ok, bad, [](json&) {},
             [&, part = part, channel = channel](const std::string& p, const std::string& c,
                                                 std::vector<char>& bytes) {
                 // Flip the lowest bit of the first value: consistent, only the checksum sees it.

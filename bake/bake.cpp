@@ -65,8 +65,15 @@ BakeResult bake(const Scene& scene, const BakeOptions& opt, const std::string& i
     BakeData& data = out.data;
     data.order = opt.order;
     data.precision = opt.precision;
-    const int rate = opt.rate > 0 ? opt.rate : rateForSampleCount(scene, opt.samples);
-    data.layout = buildJoiningLayout(scene, rate);
+    if (opt.layout == LayoutKind::Joining) {
+        const int rate = opt.rate > 0 ? opt.rate : rateForSampleCount(scene, opt.samples);
+        data.layout = buildJoiningLayout(scene, rate);
+    } else {
+        ChartOptions co = opt.charts;
+        co.kind = opt.layout;
+        co.samples = opt.samples;
+        data.layout = buildChartLayout(scene, co, &out.stats.charts);
+    }
     const SurfaceLayout& L = data.layout;
     const size_t n = L.position.size();
     const int K = shEvenCount(opt.order);
@@ -175,6 +182,23 @@ BakeResult bake(const Scene& scene, const BakeOptions& opt, const std::string& i
     st.traceSeconds = traceNs * 1e-9, st.compressSeconds = compressNs * 1e-9;
     st.wallSeconds = secondsSince(t0);
     st.rhoOverhead = rhoOverhead(L);
+    nlohmann::json layoutInfo = {{"kind", ToString(L.kind)}};
+    if (L.isChartLayout()) {
+        const ChartStats& c = st.charts;
+        layoutInfo["method"] = L.kind == LayoutKind::Isolated ? ToString(opt.charts.method) : "mesh uv";
+        layoutInfo["seamMesh"] = c.seamMesh;
+        layoutInfo["coneDegrees"] = opt.charts.coneDegrees;
+        layoutInfo["maxDensityRatio"] = opt.charts.maxDensityRatio;
+        layoutInfo["splits"] = c.splits;
+        layoutInfo["arapCharts"] = c.arapCharts;
+        layoutInfo["texelsPerObjectUnit"] = c.texelsPerObjectUnit;
+        layoutInfo["densitySpread"] = c.densitySpread;
+        layoutInfo["maxConformalDistortion"] = c.maxConformalDistortion;
+        layoutInfo["seamEdges"] = c.seamEdges;
+        layoutInfo["creaseEdges"] = c.creaseEdges;
+        layoutInfo["borderEdges"] = c.borderEdges;
+        layoutInfo["gutterTexels"] = c.gutterTexels;
+    }
 
     nlohmann::json media = nlohmann::json::array();
     std::vector<std::string> checksums;
@@ -202,6 +226,7 @@ BakeResult bake(const Scene& scene, const BakeOptions& opt, const std::string& i
                 {"stored", "l+m even, even order: l = 0..L, m = -l, -l+2, ..., l"},
                 {"channels", "exit x, y, z (object space), path length"}}},
         {"frame", "Duff et al. 2017 orthonormal basis from the shading normal, z = normal"},
+        {"layout", layoutInfo},
         {"stats", {{"paths", st.paths}, {"rays", st.rays}, {"tir", st.tir}, {"capped", st.capped},
                    {"softCapped", st.softCapped}, {"reentered", st.reentered},
                    {"geometricNormal", st.geometricNormal}, {"leaked", st.leaked},

@@ -7,6 +7,7 @@
 #include <functional>
 #include <string>
 
+#include "bake/charts.h"
 #include "bake/fit.h"
 #include "bake/tracer.h"
 #include "common/bakefile.h"
@@ -32,8 +33,11 @@ Fit parseFit(const std::string& text);  // throws InputError
 
 struct BakeOptions {
     int order = 8;           // SH order L
-    int rate = 0;            // grid steps per triangle edge; 0: from `samples`
-    size_t samples = 35000;  // target unique sample count when rate == 0 (the paper's bunny)
+    LayoutKind layout = LayoutKind::Joining;
+    int rate = 0;            // joining: grid steps per triangle edge; 0: from `samples`
+    size_t samples = 35000;  // target unique sample count when rate == 0 (the paper's bunny);
+                             // chart layouts: target covered texels
+    ChartOptions charts;     // isolated and uv (its kind and samples are set from the above)
     DirectionGrid grid;      // 32 x 64 = 2048 directions, the paper's count
     TraceOptions trace;
     double filterWidth = 0.0;  // semi-Gaussian width in bands; <= 0: none
@@ -51,7 +55,8 @@ struct BakeStats {
     size_t tir = 0, capped = 0, softCapped = 0, reentered = 0, geometricNormal = 0, leaked = 0;
     double traceSeconds = 0, compressSeconds = 0;  // summed over threads
     double wallSeconds = 0;
-    double rhoOverhead = 0;  // rho texels per unique sample
+    double rhoOverhead = 0;  // rho texels per unique sample (chart layouts: atlas texels)
+    ChartStats charts;       // isolated and uv layouts
 };
 
 struct BakeResult {

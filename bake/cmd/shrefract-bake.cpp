@@ -36,10 +36,29 @@ int main(int argc, char** argv) {
     app.add_option("input", input, "mesh (.obj .off .ply .stl) or scene (.json)")->required();
     app.add_option("-o,--output", output, "output file, NAME.shrefract.exr")->required();
     app.add_option("--order", opt.order, "SH order L: bands 0..L")->capture_default_str()->check(CLI::Range(0, 20));
-    auto* rateOpt = app.add_option("--rate", rate, "grid steps per triangle edge (overrides --samples)")
+    std::string layout = "joining", texels;
+    app.add_option("--layout", layout,
+                   "joining: every triangle on a barycentric grid (paper 5.3); isolated: charts cut "
+                   "and unfolded by CGAL into an atlas (paper 5.2); uv: the mesh's own texture "
+                   "coordinates as the charts")
+        ->capture_default_str()->check(CLI::IsMember({"joining", "isolated", "uv"}));
+    auto* rateOpt = app.add_option("--rate", rate, "joining: grid steps per triangle edge (overrides --samples)")
                         ->check(CLI::Range(1, 64));
-    app.add_option("--samples", samples, "target number of unique surface samples")
-        ->capture_default_str()->check(CLI::Range(size_t(1), size_t(50'000'000)))->excludes(rateOpt);
+    auto* texelsOpt = app.add_option("--texels", texels,
+                                     "isolated, uv: the atlas size WxH or W (square), instead of "
+                                     "the one whose covered texels reach --samples");
+    app.add_option("--samples", samples,
+                   "target number of surface samples (joining: unique grid samples; isolated, uv: "
+                   "covered texels)")
+        ->capture_default_str()->check(CLI::Range(size_t(1), size_t(50'000'000)))->excludes(rateOpt)
+        ->excludes(texelsOpt);
+    app.add_option("--gutter", opt.charts.gutter,
+                   "isolated: texels kept free around every chart; isolated, uv: gutter texels that "
+                   "get seam-aware sources")
+        ->capture_default_str()->check(CLI::Range(0, 64));
+    app.add_option("--cone", opt.charts.coneDegrees,
+                   "isolated: largest angle in degrees between a face's normal and its chart's seed")
+        ->capture_default_str()->check(CLI::Range(1.0, 89.0));
     app.add_option("--grid", grid, "view directions over the hemisphere, NTHETAxNPHI")->capture_default_str();
     app.add_option("--ior", ior, "index of refraction for a bare mesh")->capture_default_str()->check(CLI::Range(1.0, 5.0));
     app.add_option("--branch", branch, "fresnel: larger Fresnel branch; transmit: refract unless TIR")
@@ -70,6 +89,23 @@ int main(int argc, char** argv) {
     try {
         opt.rate = rate;
         opt.samples = samples;
+        opt.layout = parseLayoutKind(layout);
+        if (opt.layout != LayoutKind::Joining && rate > 0)
+            throw InputError("--rate is for --layout joining; chart layouts take --samples or --texels");
+        if (opt.layout == LayoutKind::Joining && !texels.empty())
+            throw InputError("--texels is for --layout isolated or uv");
+        if (opt.layout != LayoutKind::Joining && targetError > 0)
+            throw InputError("--target-error searches joining layouts only");
+        if (!texels.empty()) {
+            int w = 0, h = 0;
+            char x = 0, extra = 0;
+            const int got = std::sscanf(texels.c_str(), "%d%c%d%c", &w, &x, &h, &extra);
+            if (got == 1) h = w;
+            if (!((got == 1) || (got == 3 && (x == 'x' || x == 'X'))) || w < 1 || h < 1 ||
+                w > 16384 || h > 16384)
+                throw InputError("--texels: expected WxH or W (1 to 16384), got '" + texels + "'");
+            opt.charts.texels = {w, h};
+        }
         opt.grid = parseGrid(grid, "--grid");
         opt.trace.branch = branch == "transmit" ? Branch::Transmit : Branch::Fresnel;
         opt.precision = parsePrecision(precision);
@@ -136,6 +172,7 @@ int main(int argc, char** argv) {
         opt.cancel = &gCancel;
 
         BakeResult res = bake(scene, opt, input);
+        for (const std::string& w : res.stats.charts.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
         if (!quiet && tty) std::fprintf(stderr, "\n");
         if (gCancel) throw Cancelled();
         writeBake(output, res.data);
@@ -144,9 +181,23 @@ int main(int argc, char** argv) {
         auto pct = [&](size_t k) { return 100.0 * double(k) / double(std::max<size_t>(1, s.paths)); };
         const SurfaceLayout& L = res.data.layout;
         std::printf("baked %s -> %s\n", input.c_str(), output.c_str());
-        std::printf("  samples     %zu (rate %d, %d triangles), mu %dx%d, rho %dx%d (%.2f texels/sample)\n",
-                    s.samples, L.rate, L.triangleCount, L.muWidth, L.muHeight, L.rhoWidth, L.rhoHeight,
-                    s.rhoOverhead);
+        if (L.isChartLayout()) {
+            const ChartStats& c = s.charts;
+            std::printf("  samples     %zu covered texels of a %dx%d atlas (%.2f texels/sample), %s "
+                        "layout, %d triangles\n",
+                        s.samples, L.muWidth, L.muHeight, s.rhoOverhead, ToString(L.kind), L.triangleCount);
+            std::printf("  charts      %d (%d splits, %d unfolded by ARAP), gutter %d, density spread "
+                        "%.2fx, largest conformal distortion %.2f\n",
+                        c.charts, c.splits, c.arapCharts, L.atlas.gutter, c.densitySpread,
+                        c.maxConformalDistortion);
+            std::printf("  cuts        %zu smooth seam edges, %zu crease edges, %zu border edges; "
+                        "%zu of %zu gutter texels seam-aware\n",
+                        c.seamEdges, c.creaseEdges, c.borderEdges, c.seamSources, c.gutterTexels);
+        } else {
+            std::printf("  samples     %zu (rate %d, %d triangles), mu %dx%d, rho %dx%d (%.2f texels/sample)\n",
+                        s.samples, L.rate, L.triangleCount, L.muWidth, L.muHeight, L.rhoWidth, L.rhoHeight,
+                        s.rhoOverhead);
+        }
         std::printf("  paths       %zu (%d directions), rays %zu (%.2f per path)\n", s.paths,
                     opt.grid.count(), s.rays, double(s.rays) / std::max<size_t>(1, s.paths));
         std::printf("  time        %.1f s wall (trace %.1f s, compress %.1f s thread time), %.2f Mrays/s\n",

@@ -22,6 +22,19 @@ const auto& write = shrefract::test::writeText;
 
 const std::string kBake = SHREFRACT_BAKE_EXE;
 constexpr const char* kTetra = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+// The tetrahedron with UVs: a net (face 0 in the middle, the other three folded out around it),
+// then the same with face 3's tip folded back onto face 0 (flipped), all four faces on one
+// triangle (overlapping), and a tip outside [0, 1].
+#define TETRA_OBJ(TIP) \
+    "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" \
+    "vt 0.5 0.35\nvt 0.35 0.6\nvt 0.65 0.6\nvt 0.2 0.35\nvt 0.8 0.35\nvt " TIP "\n" \
+    "f 1/1 3/3 2/2\nf 1/1 2/2 4/4\nf 1/1 4/5 3/3\nf 2/2 3/3 4/6\n"
+constexpr const char* kTetraUv = TETRA_OBJ("0.5 0.85");
+constexpr const char* kTetraUvFlipped = TETRA_OBJ("0.5 0.5");
+constexpr const char* kTetraUvOutside = TETRA_OBJ("0.5 1.2");
+constexpr const char* kTetraUvOverlap =
+    "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0.1 0.1\nvt 0.9 0.1\nvt 0.5 0.9\n"
+    "f 1/1 3/2 2/3\nf 1/1 2/2 4/3\nf 1/1 4/2 3/3\nf 2/1 3/2 4/3\n";
 
 // Each case: an input file's content (or none), extra arguments, and a word the message needs.
 struct BadCase {
@@ -62,8 +75,34 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"gridtext", "tetra.off", kTetra, "--grid banana", "grid"},
         BadCase{"ior", "tetra.off", kTetra, "--ior 0.5", "ior"},
         BadCase{"precision", "tetra.off", kTetra, "--precision f64", "precision"},
-        BadCase{"scene", "scene.json", "{\"parts\": [{\"mesh\": \"tetra.off\", \"ior\": -2}]}", "", "scene.json"}),
+        BadCase{"scene", "scene.json", "{\"parts\": [{\"mesh\": \"tetra.off\", \"ior\": -2}]}", "", "scene.json"},
+        BadCase{"layout", "tetra.off", kTetra, "--layout spiral", "--layout"},
+        BadCase{"chartrate", "tetra.off", kTetra, "--layout isolated --rate 2", "--rate is for --layout joining"},
+        BadCase{"texels", "tetra.off", kTetra, "--layout isolated --texels 0x5", "--texels"},
+        BadCase{"texelsjoin", "tetra.off", kTetra, "--texels 64", "--texels is for"},
+        BadCase{"uvnone", "tetra.off", kTetra, "--layout uv", "has no texture coordinates"},
+        BadCase{"uvflipped", "tetra.obj", kTetraUvFlipped, "--layout uv", "flipped in UV space"},
+        BadCase{"uvoverlap", "tetra.obj", kTetraUvOverlap, "--layout uv", "overlap in UV space"},
+        BadCase{"uvoutside", "tetra.obj", kTetraUvOutside, "--layout uv", "outside [0, 1]"}),
     [](const auto& info) { return std::string(info.param.name); });
+
+// The chart layouts bake the test objects and say what they made.
+TEST(BakeCli, ChartLayoutsBakeTheirObjects) {
+    write(tmp("net_tetra.obj"), kTetraUv);
+    const std::string data = SHREFRACT_DATA_DIR;
+    const std::pair<std::string, std::string> cases[] = {
+        {data + "/scenes/flat_cube.obj --layout isolated", "6 (0 splits"},
+        {data + "/scenes/vase.obj --layout uv", "uv layout"},
+        {tmp("net_tetra.obj") + " --layout uv", "uv layout"}};
+    for (const auto& [args, expect] : cases) {
+        const std::string out = tmp("chart.shrefract.exr");
+        fs::remove(out);
+        CommandResult r = run(kBake + " " + args + " -o " + out + " --samples 2000 --order 1 --grid 4x8 --cache ''");
+        EXPECT_EQ(r.code, 0) << r.out;
+        EXPECT_NE(r.out.find(expect), std::string::npos) << r.out;
+        EXPECT_TRUE(fs::exists(out)) << args;
+    }
+}
 
 TEST(BakeCli, MissingOutputFolderIsAnErrorBeforeAnyWork) {
     write(tmp("nodir_tetra.off"), kTetra);

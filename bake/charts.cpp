@@ -592,16 +592,37 @@ void forEachCoveredTexel(const glm::dvec2 uv[3], const std::array<bool, 3>& open
 
 // Covered texels of every chart at `scale` texels per chart unit, each at (gutter, gutter) of its
 // own box: the count does not depend on where the packer puts the box (whole texels).
-size_t coveredAtScale(const Surface& S, const std::vector<std::array<bool, 3>>& open, double scale,
-                      int gutter) {
+// Texel centres covered by the triangles `tris` placed by `place` in a width x height grid, each
+// counted once (a centre on an edge inside a chart is covered by both of its triangles).
+template <class Place>
+size_t countCovered(const Surface& S, const std::vector<std::array<bool, 3>>& open,
+                    const std::vector<uint32_t>& tris, Place place, int width, int height) {
+    std::vector<char> covered(size_t(width) * height, 0);
     size_t n = 0;
-    for (uint32_t t = 0; t < S.tris.size(); ++t) {
+    for (uint32_t t : tris) {
         glm::dvec2 uv[3];
-        for (int k = 0; k < 3; ++k) uv[k] = S.tris[t].uv[k] * scale + double(gutter);
-        const int side = 1 << 30;
-        forEachCoveredTexel(uv, open[t], side, side, [&](int, int, const double*) { ++n; });
+        for (int k = 0; k < 3; ++k) uv[k] = place(S.tris[t].uv[k]);
+        forEachCoveredTexel(uv, open[t], width, height, [&](int x, int y, const double*) {
+            char& c = covered[size_t(y) * width + x];
+            n += !c;
+            c = 1;
+        });
     }
-    return n;  // texels shared by two triangles of a chart count once there, twice here: rare
+    return n;
+}
+
+// Covered texels of every chart at `scale` texels per chart unit, each at (gutter, gutter) of its
+// own box: the count does not depend on where the packer puts the box (whole texels).
+size_t coveredAtScale(const Surface& S, const std::vector<std::array<bool, 3>>& open,
+                      const std::vector<std::vector<uint32_t>>& faces,
+                      const std::vector<ChartBox>& boxes, double scale, int gutter) {
+    size_t n = 0;
+    for (size_t c = 0; c < faces.size(); ++c) {
+        const int w = int(std::ceil(boxes[c].hi.x * scale)) + 2 * gutter + 1;
+        const int h = int(std::ceil(boxes[c].hi.y * scale)) + 2 * gutter + 1;
+        n += countCovered(S, open, faces[c], [&](glm::dvec2 uv) { return uv * scale + double(gutter); }, w, h);
+    }
+    return n;
 }
 
 struct Packing {
@@ -710,14 +731,10 @@ SurfaceLayout buildChartLayout(const Scene& scene, const ChartOptions& opt, Char
     if (opt.kind == LayoutKind::Uv) {
         takeMeshUVs(S, scene, st);
         const auto open = outlineEdges(S);
+        std::vector<uint32_t> all(S.tris.size());
+        std::iota(all.begin(), all.end(), 0u);
         auto covered = [&](int w, int h) {
-            size_t n = 0;
-            for (uint32_t t = 0; t < S.tris.size(); ++t) {
-                glm::dvec2 uv[3];
-                for (int k = 0; k < 3; ++k) uv[k] = S.tris[t].uv[k] * glm::dvec2(w, h);
-                forEachCoveredTexel(uv, open[t], w, h, [&](int, int, const double*) { ++n; });
-            }
-            return n;
+            return countCovered(S, open, all, [&](glm::dvec2 uv) { return uv * glm::dvec2(w, h); }, w, h);
         };
         if (opt.texels.x > 0) {
             W = opt.texels.x, H = opt.texels.y;
@@ -757,10 +774,11 @@ SurfaceLayout buildChartLayout(const Scene& scene, const ChartOptions& opt, Char
             W = opt.texels.x, H = opt.texels.y;
         } else {  // the least density whose charts cover the target number of texels
             double lo = 0, hi = std::sqrt(double(opt.samples) / area3);
-            while (coveredAtScale(S, open, hi, G) < opt.samples) hi *= 1.25;
+            const auto faces = facesByChart(S, charts);
+            while (coveredAtScale(S, open, faces, boxes, hi, G) < opt.samples) hi *= 1.25;
             for (int i = 0; i < 50 && hi - lo > 1e-6 * hi; ++i) {
                 const double mid = 0.5 * (lo + hi);
-                (coveredAtScale(S, open, mid, G) >= opt.samples ? hi : lo) = mid;
+                (coveredAtScale(S, open, faces, boxes, mid, G) >= opt.samples ? hi : lo) = mid;
             }
             scale = hi;
             packing = packSquare(boxes, scale, G);

@@ -77,7 +77,15 @@ int main(int argc, char** argv) {
                    "raytrace: stratified samples per pixel for the colour (64: the anti-aliased "
                    "reference); the direction buffer keeps the pixel centre")
         ->capture_default_str()->check(CLI::Range(1, 4096));
-    app.add_flag("--smooth", smoothing, "spatial smoothing through the neighbour lists");
+    app.add_flag("--smooth", smoothing, "spatial smoothing (neighbour lists; texture space for charts)");
+    int gutter = -1;
+    std::string seamAware = "on";
+    app.add_option("--gutter", gutter,
+                   "chart layouts: gutter rings filled by dilation (default: the bake's; 0: none)")
+        ->check(CLI::Range(-1, 64));
+    app.add_option("--seam-aware", seamAware,
+                   "chart layouts: gutter texels at smooth seams take the values across the cut")
+        ->capture_default_str()->check(CLI::IsMember({"on", "off"}));
     app.add_option("--exposure", exposure, "exposure before the tone map")->capture_default_str();
     app.add_option("--out", out, "tone-mapped PNG");
     app.add_option("--out-exr", outExr, "linear HDR RGBA EXR");
@@ -183,13 +191,24 @@ int main(int argc, char** argv) {
                 options.form = form;
                 options.order = order;
                 options.smoothing = smoothing;
+                options.gutter = gutter;
+                options.seamAware = seamAware == "on";
                 options.loader = context->loader();
                 auto refractor = shrefract::Refractor::create(bake, options);
-                std::printf("bake: order %d, %d samples, %d triangles, rho %dx%d; using order %d, "
-                            "%d decompression pass(es), preset %s\n",
+                std::printf("bake: order %d, %d samples, %d triangles, %s layout, %s %dx%d; using "
+                            "order %d, %d decompression pass(es), preset %s\n",
                             bake.order(), bake.sampleCount(), bake.triangleCount(),
+                            bake.layout().c_str(), bake.layout() == "joining" ? "rho" : "atlas",
                             refractor->refractionMapSize().x, refractor->refractionMapSize().y,
                             refractor->order(), refractor->passCount(), preset.c_str());
+                if (bake.layout() != "joining")
+                    std::printf("charts: gutter %d texels, seam-aware %s\n", refractor->gutter(),
+                                refractor->seamAware() ? "on" : "off");
+                const shrefract::GpuMemory& mem = refractor->memory();
+                std::printf("GPU memory: %.3f MB (weights %.3f, samples %.3f, rho/index %.3f, "
+                            "neighbours %.3f, targets %.3f)\n",
+                            mem.total() / 1e6, mem.weights / 1e6, mem.samples / 1e6, mem.rho / 1e6,
+                            mem.neighbours / 1e6, mem.targets / 1e6);
                 if (!dumpDir.empty()) refractor->dumpShaders(dumpDir);
 
                 // A first frame warms up shader compilation (llvmpipe JIT-compiles at first

@@ -24,6 +24,7 @@ int Bake::order() const { return data().order; }
 const std::vector<std::string>& Bake::warnings() const { return data().warnings; }
 int Bake::sampleCount() const { return data().layout.sampleCount(); }
 int Bake::triangleCount() const { return data().layout.triangleCount; }
+std::string Bake::layout() const { return ToString(data().layout.kind); }
 
 // The first medium of the manifest is the object's (docs/format.md "media").
 static const nlohmann::json* firstMedium(const BakeData& d) {

@@ -105,6 +105,11 @@ Loader currentContextLoader();
 // Compiles and links a program; throws std::runtime_error with the info log and `what`.
 GLuint buildProgram(const std::string& vertex, const std::string& fragment, const std::string& what);
 
+// A 2D texture with `filter` for minification and magnification and GL_CLAMP_TO_EDGE, from
+// `data` (tightly packed rows; nullptr: undefined contents). Leaves it bound to GL_TEXTURE_2D.
+GLuint makeTexture2D(GLenum internal, int w, int h, GLenum format, GLenum type, const void* data,
+                     GLenum filter);
+
 // GL error check that compiles out of release builds (STYLE.md).
 #ifdef NDEBUG
 #define SHREFRACT_GL_CHECK() ((void)0)

@@ -5,6 +5,10 @@
 //                   refined mesh, D fetched per vertex and interpolated by the rasterizer;
 //                   or, with vertex decompression, one draw: the shading pass's vertex shader
 //                   evaluates the SH at each sample itself.
+//   charts (paper §5.2, Figure 6; chart bakes): the unfolded mesh drawn in texture space for the
+//                   local view and D (only covered texels) -> gutters (dilation, seam-aware)
+//                   -> [texture-space smoothing] into the atlas refraction map -> shade as rho.
+//                   runtime/src/chart_pipeline.{h,cpp}.
 #include <algorithm>
 #include <cstring>
 #include <map>
@@ -13,6 +17,7 @@
 #include <glm/gtc/matrix_inverse.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "chart_pipeline.h"
 #include "common/bakefile.h"
 #include "common/error.h"
 #include "common/sh.h"
@@ -27,20 +32,6 @@ namespace shrefract {
 using namespace gl;
 
 namespace {
-
-GLuint makeTexture2D(GLenum internal, int w, int h, GLenum format, GLenum type, const void* data,
-                     GLenum filter) {
-    GLuint t = 0;
-    glGenTextures(1, &t);
-    glBindTexture(GL_TEXTURE_2D, t);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glTexImage2D(GL_TEXTURE_2D, 0, internal, w, h, 0, format, type, data);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    return t;
-}
 
 // A float render target with its own framebuffer.
 struct Target {
@@ -118,6 +109,8 @@ struct Refractor::Impl {
     GLuint lastD = 0;            // texture holding the D_mu fed to unpack or to the direct shading
     bool rhoReady = false;       // the rho target holds the map for the last update()
     glm::vec3 lastEye{0, 0, 3};  // object space, of the last update()
+    // Chart bakes: the isolated-surface pipeline, whose refraction map (the atlas) is `rho`.
+    std::unique_ptr<ChartPipeline> charts;
 
     void use() const { ensureLoaded(loader); }
     const Compiled& compiledFor(int L);
@@ -142,6 +135,7 @@ struct Refractor::Impl {
     void buildRhoMesh();
     GLuint directTextureProgram();
     void unpackRho(bool timed);
+    void buildChartMap(bool timed);
 };
 
 // Binds the weight samplers of `pass` from texture unit `firstUnit` on (the pass's own order of
@@ -168,7 +162,10 @@ const Refractor::Impl::Compiled& Refractor::Impl::compiledFor(int L) {
     const int K = shEvenCount(L);
     for (size_t i = 0; i < c.shaders.passes.size(); ++i) {
         const DecompressionPass& pass = c.shaders.passes[i];
-        GLuint p = buildProgram(c.shaders.vertex, pass.fragment,
+        // Chart bakes rasterize the unfolded mesh instead of the full-screen triangle, so only
+        // covered texels are decompressed (paper §5.2).
+        GLuint p = buildProgram(charts ? ChartPipeline::textureSpaceVertexShader() : c.shaders.vertex,
+                                pass.fragment,
                                 "decompression pass " + std::to_string(i + 1) + " (" +
                                     c.shaders.summary() + ")");
         glUseProgram(p);
@@ -242,8 +239,14 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
         throw std::invalid_argument("shrefract: shading \"" + options.shading + "\" (spread | sharp)");
     m->spread = options.shading == "spread";
 
-    // Which path, and where the SH are evaluated on the direct one.
-    if (options.path == "auto")
+    // Which path, and where the SH are evaluated on the direct one. Chart bakes have their own.
+    const bool charts = L.isChartLayout();
+    if (charts && options.path != "auto" && options.path != "charts")
+        throw std::invalid_argument("shrefract: path \"" + options.path + "\" for a " +
+                                    ToString(L.kind) + " bake (chart bakes take \"charts\")");
+    if (charts)
+        m->direct = false;
+    else if (options.path == "auto")
         m->direct = options.preset != "2006";
     else if (options.path == "direct" || options.path == "rho")
         m->direct = options.path == "direct";
@@ -281,12 +284,20 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
         throw std::invalid_argument("shrefract: vertex decompression needs a one-pass preset");
 
     // Samples (P, N), mu layout: the view pass reads them, and so does the direct path's
-    // vertex shader (gl_VertexID = sample).
-    m->positionTex = makeTexture2D(GL_RGB32F, m->muW, m->muH, GL_RGB, GL_FLOAT,
-                                   muImage3(L.position, m->muW, m->muH).data(), GL_NEAREST);
-    m->normalTex = makeTexture2D(GL_RGB32F, m->muW, m->muH, GL_RGB, GL_FLOAT,
-                                 muImage3(L.normal, m->muW, m->muH).data(), GL_NEAREST);
-    m->memory.samples = 2 * muTexels * 12;  // RGB32F
+    // vertex shader (gl_VertexID = sample). Chart bakes take P and N from their mesh.
+    if (!charts) {
+        m->positionTex = makeTexture2D(GL_RGB32F, m->muW, m->muH, GL_RGB, GL_FLOAT,
+                                       muImage3(L.position, m->muW, m->muH).data(), GL_NEAREST);
+        m->normalTex = makeTexture2D(GL_RGB32F, m->muW, m->muH, GL_RGB, GL_FLOAT,
+                                     muImage3(L.normal, m->muW, m->muH).data(), GL_NEAREST);
+        m->memory.samples = 2 * muTexels * 12;  // RGB32F
+    }
+    // Where sample i sits in the mu textures: texel i, or its atlas texel for chart bakes.
+    std::vector<size_t> texelOf(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) {
+        const glm::ivec2 t = L.muTexel(i);
+        texelOf[i] = static_cast<size_t>(t.y) * m->muW + t.x;
+    }
 
     // Only bands 0..maxOrder go to the GPU: the weights are coefficient-major, so those are the
     // first shEvenCount(maxOrder) layers.
@@ -319,9 +330,11 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
             for (size_t i = 0; i < size_t(n) * 4; ++i) {
                 const double scale = d.u8Scale[k * 4 + i % 4], offset = d.u8Offset[k * 4 + i % 4];
                 const double code = scale > 0 ? std::nearbyint((double(w[i]) - offset) / scale) : 0.0;
-                codes[i] = static_cast<uint8_t>(std::clamp(code, 0.0, 255.0));
+                codes[texelOf[i / 4] * 4 + i % 4] = static_cast<uint8_t>(std::clamp(code, 0.0, 255.0));
             }
             data = codes.data();
+        } else if (charts) {
+            for (int i = 0; i < n; ++i) std::memcpy(&padded[texelOf[i] * 4], &w[size_t(i) * 4], 4 * sizeof(float));
         } else {
             std::memcpy(padded.data(), w, static_cast<size_t>(n) * 4 * sizeof(float));
         }
@@ -396,6 +409,16 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
         glBindVertexArray(0);
         m->memory.mesh = indices.size() * sizeof(uint32_t);
         if (!m->vertexMode()) m->directTextureProgram();
+    } else if (charts) {
+        // The atlas is the refraction map; the unfolded mesh draws it in texture space and shades.
+        m->rho.create(m->rhoW, m->rhoH, GL_LINEAR);
+        m->memory.targets += muTexels * 16;
+        m->buildRhoMesh();
+        m->charts = std::make_unique<ChartPipeline>(
+            L, m->rhoVao, m->rhoVertexCount, options.gutter < 0 ? L.atlas.gutter : options.gutter,
+            options.seamAware);
+        m->memory.rho = m->charts->indexBytes();
+        m->memory.targets += m->charts->targetBytes();
     } else {
         m->ensureRhoResources();
         m->buildRhoMesh();
@@ -442,18 +465,28 @@ void Refractor::Impl::ensureRhoResources() {
     glUseProgram(0);
 }
 
-// The rho path's shading: its program and the mesh rebuilt from rho and the samples: triangle
-// t's corners are its grid samples (0,0), (r,0), (0,r); UVs point at their texel centres in rho.
+// The rho path's shading (and the chart path's): its program and the mesh, UVs into the map.
 void Refractor::Impl::buildRhoMesh() {
     const SurfaceLayout& L = bake.data().layout;
     shadeRhoProgram = buildProgram(shaders::source("shade.vert"), shaders::source("shade.frag"), "shading");
     glUseProgram(shadeRhoProgram);
     setInt(shadeRhoProgram, "uRho", 1);
     glUseProgram(0);
+    // Joining: triangle t's corners are its grid samples (0,0), (r,0), (0,r), UVs at their texel
+    // centres in rho. Charts: the unfolded mesh with its atlas UVs.
     const int r = L.rate;
     std::vector<float> vertices;
     vertices.reserve(static_cast<size_t>(L.triangleCount) * 3 * 8);
-    for (int t = 0; t < L.triangleCount; ++t) {
+    for (int t = 0; t < L.triangleCount && L.isChartLayout(); ++t) {
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t v = L.atlas.triangles[t][k];
+            const glm::vec3 p = L.atlas.vertexPosition[v], nn = L.atlas.vertexNormal[v];
+            const glm::vec2 uv = L.atlas.vertexUV[v];
+            const float a[8] = {p.x, p.y, p.z, nn.x, nn.y, nn.z, uv.x, uv.y};
+            vertices.insert(vertices.end(), a, a + 8);
+        }
+    }
+    for (int t = 0; t < L.triangleCount && !L.isChartLayout(); ++t) {
         const glm::ivec2 corners[3] = {{0, 0}, {r, 0}, {0, r}};
         for (glm::ivec2 c : corners) {
             uint32_t s = L.sampleAt(t, c.x, c.y);
@@ -506,6 +539,7 @@ Refractor::~Refractor() {
     for (GLuint b : {m.rhoVbo, m.directIbo})
         if (b) glDeleteBuffers(1, &b);
     glDeleteQueries(kStages, m.queries);
+    m.charts.reset();
 }
 
 void Refractor::Impl::decompressInTextureSpace(bool timed) {
@@ -515,6 +549,13 @@ void Refractor::Impl::decompressInTextureSpace(bool timed) {
         sum[0].create(muW, muH, GL_NEAREST);
         sum[1].create(muW, muH, GL_NEAREST);
         memory.targets += 3 * muBytes;
+        if (charts) {  // the passes draw the charts only: the texels around them stay 0
+            for (Target* t : {&localView, &sum[0], &sum[1]}) {
+                glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
+                glClearColor(0, 0, 0, 0);
+                glClear(GL_COLOR_BUFFER_BIT);
+            }
+        }
     }
     if (smoothing && rangeTex && !smoothed.fbo) {
         smoothed.create(muW, muH, GL_NEAREST);
@@ -535,11 +576,15 @@ void Refractor::Impl::decompressInTextureSpace(bool timed) {
     // The local view direction per sample.
     begin(kView);
     glBindFramebuffer(GL_FRAMEBUFFER, localView.fbo);
-    glUseProgram(viewProgram);
-    glUniform3f(glGetUniformLocation(viewProgram, "uEye"), lastEye.x, lastEye.y, lastEye.z);
-    bindTexture(0, GL_TEXTURE_2D, positionTex);
-    bindTexture(1, GL_TEXTURE_2D, normalTex);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    if (charts) {
+        charts->localView(lastEye);
+    } else {
+        glUseProgram(viewProgram);
+        glUniform3f(glGetUniformLocation(viewProgram, "uEye"), lastEye.x, lastEye.y, lastEye.z);
+        bindTexture(0, GL_TEXTURE_2D, positionTex);
+        bindTexture(1, GL_TEXTURE_2D, normalTex);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+    }
     end(kView, &timings.view);
 
     // D_mu: the generated passes, partial sums ping-ponging between sum[0] and sum[1].
@@ -567,7 +612,10 @@ void Refractor::Impl::decompressInTextureSpace(bool timed) {
                     break;
             }
         }
-        glDrawArrays(GL_TRIANGLES, 0, 3);
+        if (charts)
+            charts->drawFootprint();
+        else
+            glDrawArrays(GL_TRIANGLES, 0, 3);
     }
     end(kDecompress, &timings.decompress);
     if (timed) timings.passes = static_cast<int>(c.programs.size());
@@ -604,6 +652,22 @@ void Refractor::Impl::unpackRho(bool timed) {
     rhoReady = true;
 }
 
+// Chart bakes: D -> gutters (the unpack's place in the timings) -> [texture-space smoothing] into
+// the atlas refraction map.
+void Refractor::Impl::buildChartMap(bool timed) {
+    const bool timing = timed && options.timings;
+    if (timing) begin(kUnpack);
+    const GLuint filled = charts->fillGutters(lastD, smoothing ? 0 : rho.fbo);
+    if (timing) end(kUnpack, &timings.unpack);
+    if (smoothing) {
+        if (timing) begin(kSmooth);
+        charts->smooth(filled, rho.fbo);
+        if (timing) end(kSmooth, &timings.smooth);
+        lastD = rho.texture;  // readDirectionalMap(): the smoothed values
+    }
+    rhoReady = true;
+}
+
 void Refractor::update(glm::vec3 eye, const glm::mat4& model) {
     Impl& m = *impl_;
     m.use();
@@ -622,7 +686,8 @@ void Refractor::update(glm::vec3 eye, const glm::mat4& model) {
     } else {
         m.decompressInTextureSpace(true);
         // The rho path unpacks every frame; the direct path only for an app that asked for it.
-        if (!m.direct) m.unpackRho(true);
+        if (m.charts) m.buildChartMap(true);
+        else if (!m.direct) m.unpackRho(true);
         else if (m.rhoIndexTex) m.unpackRho(false);
     }
     glUseProgram(0);
@@ -695,9 +760,14 @@ unsigned Refractor::refractionMap() {
         GLint viewport[4], framebuffer = 0;
         glGetIntegerv(GL_VIEWPORT, viewport);
         glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &framebuffer);
-        m.ensureRhoResources();
-        if (m.vertexMode()) m.decompressInTextureSpace(false);
-        m.unpackRho(false);
+        if (m.charts) {
+            m.decompressInTextureSpace(false);
+            m.buildChartMap(false);
+        } else {
+            m.ensureRhoResources();
+            if (m.vertexMode()) m.decompressInTextureSpace(false);
+            m.unpackRho(false);
+        }
         glUseProgram(0);
         glBindVertexArray(0);
         glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
@@ -707,7 +777,9 @@ unsigned Refractor::refractionMap() {
 }
 
 glm::ivec2 Refractor::refractionMapSize() const { return {impl_->rhoW, impl_->rhoH}; }
-std::string Refractor::path() const { return impl_->direct ? "direct" : "rho"; }
+std::string Refractor::path() const {
+    return impl_->charts ? "charts" : impl_->direct ? "direct" : "rho";
+}
 std::string Refractor::decompression() const { return impl_->vertexMode() ? "vertex" : "texture"; }
 
 void Refractor::setOrder(int L) {
@@ -723,6 +795,16 @@ void Refractor::setSmoothing(bool on) {
     impl_->smoothing = on;
 }
 void Refractor::setCorrection(bool on) { impl_->correction = on; }
+void Refractor::setGutter(int texels) {
+    if (!impl_->charts) return;
+    impl_->use();
+    impl_->charts->setDilation(texels < 0 ? impl_->bake.data().layout.atlas.gutter : texels);
+}
+int Refractor::gutter() const { return impl_->charts ? impl_->charts->dilation() : 0; }
+void Refractor::setSeamAware(bool on) {
+    if (impl_->charts) impl_->charts->setSeamAware(on);
+}
+bool Refractor::seamAware() const { return impl_->charts && impl_->charts->seamAware(); }
 void Refractor::setTimings(bool on) {
     if (!on) impl_->timings = Timings{};
     impl_->options.timings = on;
@@ -751,6 +833,22 @@ static std::vector<float> readTexture(GLuint texture, int w, int h) {
     return out;
 }
 
+// A mu-layout texture read back in sample order (chart bakes: each sample from its atlas texel).
+static std::vector<float> readSamples(const Refractor::Impl& m, GLuint texture) {
+    std::vector<float> all = readTexture(texture, m.muW, m.muH);
+    const SurfaceLayout& L = m.bake.data().layout;
+    if (L.isChartLayout()) {
+        std::vector<float> samples(static_cast<size_t>(L.sampleCount()) * 4);
+        for (int i = 0; i < L.sampleCount(); ++i) {
+            const glm::ivec2 t = L.muTexel(i);
+            std::copy_n(&all[(static_cast<size_t>(t.y) * m.muW + t.x) * 4], 4, &samples[size_t(i) * 4]);
+        }
+        return samples;
+    }
+    all.resize(static_cast<size_t>(L.sampleCount()) * 4);
+    return all;
+}
+
 std::vector<float> Refractor::readDirectionalMap() const {
     Impl& m = *impl_;
     m.use();
@@ -763,17 +861,13 @@ std::vector<float> Refractor::readDirectionalMap() const {
         glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
         glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
     }
-    std::vector<float> all = readTexture(m.lastD, m.muW, m.muH);
-    all.resize(static_cast<size_t>(m.bake.sampleCount()) * 4);
-    return all;
+    return readSamples(m, m.lastD);
 }
 
 std::vector<float> Refractor::readLocalViewMap() const {
     impl_->use();
     if (!impl_->localView.texture) readDirectionalMap();
-    std::vector<float> all = readTexture(impl_->localView.texture, impl_->muW, impl_->muH);
-    all.resize(static_cast<size_t>(impl_->bake.sampleCount()) * 4);
-    return all;
+    return readSamples(*impl_, impl_->localView.texture);
 }
 
 std::vector<float> Refractor::readRefractionMap() {

@@ -10,27 +10,20 @@
 #include "shrefract/context.h"
 #include "shrefract/render.h"
 #include "shrefract/runtime.h"
+#include "headless_test.h"
 #include "test_bake.h"
 
 namespace shrefract {
 namespace {
 
-class GlTest : public ::testing::TestWithParam<Backend> {
+class GlTest : public test::HeadlessTest {
 protected:
-    void SetUp() override {
-        try {
-            context_ = createHeadlessContext(GetParam(), 64, 64);
-        } catch (const ContextError& e) {
-            GTEST_SKIP() << "no " << ToString(GetParam()) << " context: " << e.what();
-        }
-    }
     std::unique_ptr<Refractor> refractor(const Bake& bake, const std::string& preset = "modern") {
         RefractorOptions o;
         o.preset = preset;
         o.loader = context_->loader();
         return Refractor::create(bake, o);
     }
-    std::unique_ptr<HeadlessContext> context_;
 };
 
 // max over samples and channels of |GL - CPU| for D_mu.

@@ -21,17 +21,12 @@ inline Mesh octahedron() {
     return m;
 }
 
-// Random weights in [-1, 1] for x, y, z and [0, 2] for the length; band 0 biased so the exit
-// direction is rarely near zero.
-inline BakeData randomBake(int order, int rate, unsigned seed = 7) {
-    Scene scene;
-    Part part;
-    part.name = "octahedron";
-    part.mesh = octahedron();
-    scene.parts.push_back(part);
+// A bake of `layout` (any kind) with random weights in [-1, 1] for x, y, z and [0, 2] for the
+// length; band 0 biased so the exit direction is rarely near zero.
+inline BakeData randomBake(SurfaceLayout layout, int order, unsigned seed = 7) {
     BakeData d;
     d.order = order;
-    d.layout = buildJoiningLayout(scene, rate);
+    d.layout = std::move(layout);
     d.manifest = {{"media", {{{"name", "glass"}, {"ior", 1.5}, {"absorption", {0.1, 0.2, 0.3}}}}}};
     const size_t n = d.layout.position.size();
     d.weights.resize(shEvenCount(order) * n * 4);
@@ -45,6 +40,16 @@ inline BakeData randomBake(int order, int rate, unsigned seed = 7) {
                 d.weights[(k * n + i) * 4 + c] = w;
             }
     return d;
+}
+
+// The octahedron's joining layout at `rate`, random weights.
+inline BakeData randomBake(int order, int rate, unsigned seed = 7) {
+    Scene scene;
+    Part part;
+    part.name = "octahedron";
+    part.mesh = octahedron();
+    scene.parts.push_back(part);
+    return randomBake(buildJoiningLayout(scene, rate), order, seed);
 }
 
 }  // namespace shrefract::test

@@ -20,6 +20,9 @@ public:
     int order() const;          // L stored
     int sampleCount() const;    // |O_d|
     int triangleCount() const;
+    // The surface layout: "joining" (paper §5.3: every triangle on a barycentric grid, seamless),
+    // "isolated" (paper §5.2: charts in an atlas with gutters) or "uv" (the mesh's own UVs).
+    std::string layout() const;
     float ior() const;          // manifest media[0].ior, else 1.5
     glm::vec3 absorption() const;  // manifest media[0].absorption (kappa per RGB), else 0
     // What loading noticed that the app should show its user, e.g. an older format version
@@ -75,8 +78,8 @@ glm::vec3 toneMap(glm::vec3 hdr, float exposure = 1.0f);
 struct Timings {
     double view = 0;        // eye -> local view direction per sample
     double decompress = 0;  // D_mu, all generated passes (0 when the vertex shader decompresses)
-    double smooth = 0;      // neighbour-list smoothing (0 when off)
-    double unpack = 0;      // mu -> rho with correction texels (rho path only)
+    double smooth = 0;      // neighbour-list smoothing, texture-space for charts (0 when off)
+    double unpack = 0;      // mu -> rho with correction texels (rho path); chart layouts: the gutters
     double shade = 0;       // draw() (with the decompression, when the vertex shader does it)
     int passes = 0;         // decompression passes used (0 when the vertex shader decompresses)
 };
@@ -87,7 +90,8 @@ struct GpuMemory {
     size_t weights = 0;     // SH weights of the uploaded bands, mu size each, at the GPU format
                             // (RGBA32F, RGBA16F or RGBA8: see RefractorOptions::halfWeights)
     size_t samples = 0;     // positions and normals, RGB32F, mu size
-    size_t rho = 0;         // rho index texture (rho path, or refractionMap() on the direct path)
+    size_t rho = 0;         // rho index texture (rho path, or refractionMap() on the direct path);
+                            // chart layouts: gutter rings and seam sources
     size_t neighbours = 0;  // smoothing lists (CSR)
     size_t mesh = 0;        // vertex and index buffers of the drawn mesh
     size_t targets = 0;     // render targets: local view, partial sums, smoothed, rho
@@ -106,7 +110,8 @@ struct RefractorOptions {
     // How the refraction map is interpolated across triangles (docs/runtime.md "Interpolation
     // paths"): "rho" is the paper's texture-space layout with correction texels and an unpack
     // pass; "direct" draws the sample grid as a refined mesh and lets the rasterizer interpolate;
-    // "auto": direct for the modern preset, rho for 2006.
+    // "auto": direct for the modern preset, rho for 2006. Chart bakes (isolated, uv) take their
+    // own path, "charts" (paper §5.2, Figure 6): "auto" or "charts" there, anything else throws.
     std::string path = "auto";
     // Direct path: where the SH are evaluated. "vertex": in the shading pass's vertex shader (one
     // draw; needs a one-pass preset and no smoothing); "texture": decompression passes into D_mu
@@ -126,6 +131,11 @@ struct RefractorOptions {
     std::string shading = "spread";
     float spreadScale = 1.0f;       // lobe width factor (spread shading)
     float footprintScale = 0.5f;    // screen-space footprint factor (spread shading)
+    // Chart layouts (isolated, uv; paper §5.2): gutter rings filled around the charts by
+    // dilation (-1: the bake's gutter; 0: none), and whether gutter texels next to a smooth seam
+    // take the values across the cut instead (seam-aware filling, docs/runtime.md).
+    int gutter = -1;
+    bool seamAware = true;
     bool timings = true;            // GL timer queries around every stage
     bool toneMap = false;           // draw() writes display values (toneMap()) instead of HDR
     float exposure = 1.0f;
@@ -143,17 +153,24 @@ public:
     // toneMap), world exit direction + coverage 1 to draw buffer 1 when one is bound.
     void draw(const glm::mat4& view, const glm::mat4& projection, const glm::mat4& model,
               const Environment& environment);
-    // The refraction map for an app's own material: GL_TEXTURE_2D, RGBA32F, rho layout,
-    // GL_LINEAR (docs/integrate.md). On the direct path it is built on first request (rho index
-    // and target allocated then) and kept up to date by every later update().
+    // The refraction map for an app's own material: GL_TEXTURE_2D, RGBA32F, GL_LINEAR: the rho
+    // layout (docs/integrate.md), or for chart bakes the atlas, in the mesh's own UV space for uv
+    // bakes (looked up at the app's texture coordinates). On the direct path it is built on first
+    // request (rho index and target allocated then) and kept up to date by every later update().
     unsigned refractionMap();
     glm::ivec2 refractionMapSize() const;
-    std::string path() const;           // "rho" or "direct"
+    std::string path() const;           // "rho", "direct", or "charts" for chart bakes
     std::string decompression() const;  // "texture" or "vertex"
     // Progressive decompression (paper §6): use bands 0..L, clamped to the uploaded maxOrder.
     void setOrder(int L);
     int order() const;
     void setSmoothing(bool on);
+    // Chart layouts only (no effect on joining): gutter rings to fill (-1: the bake's), and
+    // seam-aware filling on or off.
+    void setGutter(int texels);
+    int gutter() const;
+    void setSeamAware(bool on);
+    bool seamAware() const;
     void setCorrection(bool on);  // off only to show the seams it removes
     // GL timer queries per stage (RefractorOptions::timings); off zeroes timings().
     void setTimings(bool on);

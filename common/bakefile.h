@@ -104,6 +104,20 @@ struct SurfaceLayout {
     uint32_t sampleAt(int t, int i, int j) const;
 };
 
+// One corner of the mesh a renderer draws for a layout, three per triangle. Joining: triangle
+// t's grid samples (0, 0), (r, 0), (0, r), uv at their texel centres in rho, id the mu sample.
+// Charts: the unfolded mesh, uv in the atlas, id the chart vertex.
+struct DrawCorner {
+    glm::vec3 position, normal;
+    glm::vec2 uv;
+    uint32_t id;
+};
+std::vector<DrawCorner> drawCorners(const SurfaceLayout& layout);
+// The points drawCorners' ids name (joining: the samples; charts: the chart vertices), for data
+// given per drawn vertex, such as Wyman's d_N.
+void drawPoints(const SurfaceLayout& layout, std::vector<glm::vec3>* positions,
+                std::vector<glm::vec3>* normals);
+
 struct BakeData {
     nlohmann::json manifest;  // everything descriptive: see docs/format.md
     int order = 8;            // L

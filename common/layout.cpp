@@ -47,4 +47,33 @@ uint32_t SurfaceLayout::sampleAt(int t, int i, int j) const {
     return tx.a;
 }
 
+std::vector<DrawCorner> drawCorners(const SurfaceLayout& L) {
+    std::vector<DrawCorner> corners;
+    corners.reserve(static_cast<size_t>(L.triangleCount) * 3);
+    if (L.isChartLayout()) {
+        const ChartAtlas& A = L.atlas;
+        for (const glm::uvec3& t : A.triangles)
+            for (int k = 0; k < 3; ++k)
+                corners.push_back({A.vertexPosition[t[k]], A.vertexNormal[t[k]], A.vertexUV[t[k]], t[k]});
+        return corners;
+    }
+    const int r = L.rate;
+    for (int t = 0; t < L.triangleCount; ++t) {
+        const glm::ivec2 grid[3] = {{0, 0}, {r, 0}, {0, r}};
+        for (glm::ivec2 c : grid) {
+            const uint32_t s = L.sampleAt(t, c.x, c.y);
+            const glm::ivec2 texel = L.rhoTexel(t, c.x, c.y);
+            const glm::vec2 uv((texel.x + 0.5f) / L.rhoWidth, (texel.y + 0.5f) / L.rhoHeight);
+            corners.push_back({L.position[s], L.normal[s], uv, s});
+        }
+    }
+    return corners;
+}
+
+void drawPoints(const SurfaceLayout& L, std::vector<glm::vec3>* positions,
+                std::vector<glm::vec3>* normals) {
+    *positions = L.isChartLayout() ? L.atlas.vertexPosition : L.position;
+    *normals = L.isChartLayout() ? L.atlas.vertexNormal : L.normal;
+}
+
 }  // namespace shrefract

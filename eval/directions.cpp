@@ -213,11 +213,63 @@ glm::vec2 closestBarycentric(glm::vec3 p, glm::vec3 a, glm::vec3 b, glm::vec3 c,
     return best;
 }
 
+// A chart bake: the nearest triangle of the unfolded mesh gives the point's atlas UV, the map
+// there is the runtime's (the bake's gutter, seam-aware), built by the CPU twin from the samples
+// that can reach the bilinear lookup (a window of gutter + 2 texels and its seam sources).
+glm::vec4 queryChart(const BakeData& bake, glm::vec3 p, glm::vec3 omega) {
+    const SurfaceLayout& L = bake.layout;
+    const ChartAtlas& A = L.atlas;
+    float bestD = std::numeric_limits<float>::max();
+    glm::vec2 uv(0.0f);
+    for (const glm::uvec3& t : A.triangles) {
+        float d2;
+        const glm::vec2 b = closestBarycentric(p, A.vertexPosition[t[0]], A.vertexPosition[t[1]],
+                                               A.vertexPosition[t[2]], &d2);
+        if (d2 >= bestD) continue;
+        bestD = d2;
+        uv = (1 - b.x - b.y) * A.vertexUV[t[0]] + b.x * A.vertexUV[t[1]] + b.y * A.vertexUV[t[2]];
+    }
+    const int W = L.muWidth, reach = A.gutter + 2;
+    const glm::ivec2 c(int(uv.x * W), int(uv.y * L.muHeight));
+    std::vector<int> sampleAt(size_t(W) * L.muHeight, -1);
+    for (int i = 0; i < L.sampleCount(); ++i) {
+        const glm::ivec2 t = L.muTexel(i);
+        sampleAt[size_t(t.y) * W + t.x] = i;
+    }
+    std::vector<glm::vec4> values(L.sampleCount(), glm::vec4(0.0f));
+    auto need = [&](int i) {
+        if (values[i] == glm::vec4(0.0f))
+            values[i] = decompressSample(bake, i, localViewDirection(L, i, omega));
+    };
+    std::vector<char> inWindow(size_t(W) * L.muHeight, 0);
+    for (int y = std::max(0, c.y - reach); y <= std::min(L.muHeight - 1, c.y + reach); ++y)
+        for (int x = std::max(0, c.x - reach); x <= std::min(W - 1, c.x + reach); ++x) {
+            inWindow[size_t(y) * W + x] = 1;
+            if (sampleAt[size_t(y) * W + x] >= 0) need(sampleAt[size_t(y) * W + x]);
+        }
+    for (const SeamSource& s : A.seam)
+        if (inWindow[s.texel])
+            for (int k = 0; k < 4; ++k)
+                if (s.weight[k] != 0.0f) need(int(s.sample[k]));
+    ChartMapOptions o;
+    o.dilation = A.gutter;
+    return sampleBilinear(chartRefractionMap(L, values.data(), o), W, L.muHeight, uv);
+}
+
 }  // namespace
 
 std::vector<glm::vec4> queryBake(const BakeData& bake, const std::vector<glm::vec3>& p,
                                  const std::vector<glm::vec3>& w) {
     const SurfaceLayout& L = bake.layout;
+    if (L.isChartLayout()) {
+        std::vector<glm::vec4> out(p.size());
+        for (size_t q = 0; q < p.size(); ++q) {
+            const glm::vec4 d = queryChart(bake, p[q], glm::normalize(w[q]));
+            const glm::vec3 e(d);
+            out[q] = glm::vec4(glm::length(e) > 0 ? e / glm::length(e) : e, d.w);
+        }
+        return out;
+    }
     const int r = L.rate;
     std::vector<glm::vec4> values(L.sampleCount(), glm::vec4(0.0f));
     std::vector<glm::vec4> out(p.size());

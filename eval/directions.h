@@ -35,7 +35,9 @@ std::vector<int> adaptiveOrders(const BakeData& bake, double toleranceDeg);
 
 // For each object-space surface point p and unit view direction w (toward the viewer): the
 // exit direction (normalized) and length the runtime would use there, interpolated across the
-// nearest triangle exactly as the rho layout does (interpolateRho). Viewer at infinity along w.
+// nearest triangle exactly as the rho layout does (interpolateRho); for chart bakes looked up in
+// the atlas as the runtime's refraction map holds it (chartRefractionMap: the bake's gutter,
+// seam-aware). Viewer at infinity along w.
 std::vector<glm::vec4> queryBake(const BakeData& bake, const std::vector<glm::vec3>& p,
                                  const std::vector<glm::vec3>& w);
 

@@ -176,4 +176,10 @@ std::vector<float> normalDistances(const Tracer& tracer, const std::vector<glm::
     return d;
 }
 
+std::vector<float> normalDistances(const Tracer& tracer, const SurfaceLayout& layout) {
+    std::vector<glm::vec3> p, n;
+    drawPoints(layout, &p, &n);
+    return normalDistances(tracer, p, n);
+}
+
 }  // namespace shrefract

@@ -75,5 +75,8 @@ EvalBuffer renderReference(const Tracer& tracer, const ReferenceEnvironment& env
 // surface of the scene (0 if none), measured between true surface points. Parallel.
 std::vector<float> normalDistances(const Tracer& tracer, const std::vector<glm::vec3>& p,
                                    const std::vector<glm::vec3>& n);
+// d_N at the points a renderer draws the layout's mesh with (common/bakefile.h drawPoints): what
+// shrefract::Baseline takes.
+std::vector<float> normalDistances(const Tracer& tracer, const SurfaceLayout& layout);
 
 }  // namespace shrefract

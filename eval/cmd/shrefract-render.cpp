@@ -8,6 +8,7 @@
 // runtime library itself never links the bake. Bad input: message, exit 1, and no output file.
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
 #include <sstream>
 #include <string>
 
@@ -20,8 +21,10 @@
 #include "shrefract/render.h"
 #include "shrefract/runtime.h"
 
+#include "common/decompress.h"
 #include "eval/directions.h"
 #include "eval/reference.h"
+#include "eval/seams.h"
 
 namespace {
 
@@ -102,6 +105,11 @@ int main(int argc, char** argv) {
     app.add_option("--scene", scenePath,
                    "raytrace, wyman: the baked mesh or scene, if not where the manifest says");
     app.add_option("--dump-shaders", dumpDir, "write the generated GLSL into DIR");
+    std::string seamsOf, seamsJson;
+    app.add_option("--seams-of", seamsOf,
+                   "a chart bake whose smooth seams to measure the render's jump across "
+                   "(default: this bake, if it is one)");
+    app.add_option("--seams-json", seamsJson, "write the seam jump statistics here (JSON)");
     app.add_flag("--no-verify", noVerify, "skip the bake's checksums (faster; a corrupt file may draw garbage)");
     CLI11_PARSE(app, argc, argv);
 
@@ -149,7 +157,14 @@ int main(int argc, char** argv) {
 
         std::unique_ptr<shrefract::Scene> scene;
         std::unique_ptr<shrefract::Tracer> tracer;
-        if (method == "raytrace" || method == "wyman") {
+        std::unique_ptr<shrefract::BakeData> seamBake;  // whose seams to measure across
+        if (!seamsOf.empty())
+            seamBake = std::make_unique<shrefract::BakeData>(shrefract::readBake(seamsOf));
+        else if (bake.data().layout.isChartLayout())
+            seamBake = std::make_unique<shrefract::BakeData>(bake.data());
+        if (!seamsOf.empty() && !seamBake->layout.isChartLayout())
+            throw std::invalid_argument("--seams-of " + seamsOf + ": a joining bake has no seams");
+        if (method == "raytrace" || method == "wyman" || seamBake) {
             scene = std::make_unique<shrefract::Scene>(
                 shrefract::sceneOfBake(bake.data(), bakePath, scenePath));
             tracer = std::make_unique<shrefract::Tracer>(
@@ -210,6 +225,20 @@ int main(int argc, char** argv) {
                             mem.total() / 1e6, mem.weights / 1e6, mem.samples / 1e6, mem.rho / 1e6,
                             mem.neighbours / 1e6, mem.targets / 1e6);
                 if (!dumpDir.empty()) refractor->dumpShaders(dumpDir);
+                if (bake.layout() != "joining") {  // the map's own jump across the seams
+                    refractor->update(cam.eye);
+                    const std::vector<float> m = refractor->readRefractionMap();
+                    std::vector<glm::vec4> map(m.size() / 4);
+                    for (size_t i = 0; i < map.size(); ++i)
+                        map[i] = {m[4 * i], m[4 * i + 1], m[4 * i + 2], m[4 * i + 3]};
+                    nlohmann::json st = shrefract::jumpStats(
+                        {}, shrefract::seamJumps(bake.data().layout, map));
+                    if (st["count"].get<size_t>() > 0)
+                        std::printf("refraction map across %zu smooth seam points: jump median %.3f, "
+                                    "p95 %.3f deg\n",
+                                    st["count"].get<size_t>(), st["median"].get<double>(),
+                                    st["p95"].get<double>());
+                }
 
                 // A first frame warms up shader compilation (llvmpipe JIT-compiles at first
                 // draw); the timings printed are the per-stage medians of the `frames` frames
@@ -246,10 +275,7 @@ int main(int argc, char** argv) {
                 options.tir = tir;
                 options.loader = context->loader();
                 std::vector<float> normalDistance;
-                if (tracer) {
-                    const auto& L = bake.data().layout;
-                    normalDistance = shrefract::normalDistances(*tracer, L.position, L.normal);
-                }
+                if (tracer) normalDistance = shrefract::normalDistances(*tracer, bake.data().layout);
                 auto baseline = shrefract::Baseline::create(bake, normalDistance, options);
                 shrefract::renderFrame(*baseline, env, cam, width, height);  // warm-up
                 std::vector<double> back, shade, totals;
@@ -267,6 +293,27 @@ int main(int argc, char** argv) {
             }
         }
         std::printf("ms per frame (%s): %.3f (%s)\n", method.c_str(), msPerFrame, stages.c_str());
+        if (seamBake) {
+            shrefract::ReferenceView view;
+            view.eye = cam.eye, view.target = cam.target, view.up = cam.up;
+            view.fovDegrees = cam.fovDegrees, view.width = width, view.height = height;
+            const auto pairs = shrefract::seamPixelPairs(*tracer, seamBake->layout, view);
+            nlohmann::json st = shrefract::jumpStats(pairs, shrefract::pairJumps(frame.directions, pairs));
+            if (st["count"].get<size_t>() > 0)
+                std::printf("seams: %zu pixel pairs straddle a smooth seam; exit direction jump mean "
+                            "%.3f, median %.3f, p95 %.3f deg\n",
+                            st["count"].get<size_t>(), st["mean"].get<double>(),
+                            st["median"].get<double>(), st["p95"].get<double>());
+            else
+                std::printf("seams: no pixel pair straddles a visible smooth seam\n");
+            if (!seamsJson.empty()) {
+                std::ofstream f(seamsJson + ".tmp");
+                f << st.dump(2) << "\n";
+                f.close();
+                if (!f || std::rename((seamsJson + ".tmp").c_str(), seamsJson.c_str()) != 0)
+                    throw std::runtime_error(seamsJson + ": cannot write");
+            }
+        }
         size_t covered = 0;
         for (size_t i = 3; i < frame.directions.size(); i += 4) covered += frame.directions[i] > 0;
         std::printf("coverage: %.1f%% of pixels\n", 100.0 * covered / (size_t(width) * height));

@@ -178,10 +178,9 @@ int main(int argc, char** argv) {
         // The other methods share the mesh; Wyman's d_N is cast once here.
         std::vector<float> normalDistance;
         {
-            const shrefract::SurfaceLayout& L = bake.data().layout;
             shrefract::Scene scene = shrefract::sceneOfBake(bake.data(), bakePath);
             shrefract::Tracer tracer(scene, shrefract::traceOptionsOfBake(bake.data()));
-            normalDistance = shrefract::normalDistances(tracer, L.position, L.normal);
+            normalDistance = shrefract::normalDistances(tracer, bake.data().layout);
         }
         std::vector<std::unique_ptr<shrefract::Baseline>> baselines;
         for (shrefract::BaselineMethod m : {shrefract::BaselineMethod::Single, shrefract::BaselineMethod::Wyman}) {

@@ -89,10 +89,10 @@ std::unique_ptr<Baseline> Baseline::create(const Bake& bake, const std::vector<f
     m->use();
     if (!glGetString(GL_VERSION)) throw std::runtime_error("shrefract: no current OpenGL context");
     const SurfaceLayout& L = bake.data().layout;
-    if (options.method == BaselineMethod::Wyman &&
-        normalDistance.size() != static_cast<size_t>(L.sampleCount()))
-        throw std::invalid_argument("shrefract: Wyman needs d_N for every bake sample (" +
-                                    std::to_string(L.sampleCount()) + "), got " +
+    const size_t points = L.isChartLayout() ? L.atlas.vertexPosition.size() : size_t(L.sampleCount());
+    if (options.method == BaselineMethod::Wyman && normalDistance.size() != points)
+        throw std::invalid_argument("shrefract: Wyman needs d_N for every drawn point (" +
+                                    std::to_string(points) + "), got " +
                                     std::to_string(normalDistance.size()));
     m->backProgram = buildProgram(shaders::source("baseline.vert"), shaders::source("back_face.frag"), "Wyman back faces");
     m->shadeProgram = buildProgram(shaders::source("baseline.vert"), shaders::source("baseline.frag"), "baseline shading");
@@ -100,19 +100,14 @@ std::unique_ptr<Baseline> Baseline::create(const Bake& bake, const std::vector<f
     glUniform1i(glGetUniformLocation(m->shadeProgram, "uBack"), 1);
     glUseProgram(0);
 
-    // The Refractor's mesh: triangle t's corners are its grid samples (0,0), (r,0), (0,r).
-    const int r = L.rate;
+    // The Refractor's mesh (common/bakefile.h drawCorners), d_N per drawn point.
     std::vector<float> vertices;
     vertices.reserve(static_cast<size_t>(L.triangleCount) * 3 * 7);
-    for (int t = 0; t < L.triangleCount; ++t) {
-        const glm::ivec2 corners[3] = {{0, 0}, {r, 0}, {0, r}};
-        for (glm::ivec2 c : corners) {
-            uint32_t s = L.sampleAt(t, c.x, c.y);
-            glm::vec3 p = L.position[s], n = L.normal[s];
-            float dN = normalDistance.empty() ? 0.0f : normalDistance[s];
-            float v[7] = {p.x, p.y, p.z, n.x, n.y, n.z, dN};
-            vertices.insert(vertices.end(), v, v + 7);
-        }
+    for (const DrawCorner& c : drawCorners(L)) {
+        const float dN = normalDistance.empty() ? 0.0f : normalDistance[c.id];
+        const float v[7] = {c.position.x, c.position.y, c.position.z, c.normal.x, c.normal.y,
+                            c.normal.z, dN};
+        vertices.insert(vertices.end(), v, v + 7);
     }
     m->vertexCount = L.triangleCount * 3;
     glGenVertexArrays(1, &m->vao);

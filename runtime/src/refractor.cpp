@@ -472,30 +472,13 @@ void Refractor::Impl::buildRhoMesh() {
     glUseProgram(shadeRhoProgram);
     setInt(shadeRhoProgram, "uRho", 1);
     glUseProgram(0);
-    // Joining: triangle t's corners are its grid samples (0,0), (r,0), (0,r), UVs at their texel
-    // centres in rho. Charts: the unfolded mesh with its atlas UVs.
-    const int r = L.rate;
+    // The mesh of the layout (common/bakefile.h drawCorners): for joining the triangles' corner
+    // samples with UVs at their texel centres in rho, for charts the unfolded mesh.
     std::vector<float> vertices;
-    vertices.reserve(static_cast<size_t>(L.triangleCount) * 3 * 8);
-    for (int t = 0; t < L.triangleCount && L.isChartLayout(); ++t) {
-        for (int k = 0; k < 3; ++k) {
-            const uint32_t v = L.atlas.triangles[t][k];
-            const glm::vec3 p = L.atlas.vertexPosition[v], nn = L.atlas.vertexNormal[v];
-            const glm::vec2 uv = L.atlas.vertexUV[v];
-            const float a[8] = {p.x, p.y, p.z, nn.x, nn.y, nn.z, uv.x, uv.y};
-            vertices.insert(vertices.end(), a, a + 8);
-        }
-    }
-    for (int t = 0; t < L.triangleCount && !L.isChartLayout(); ++t) {
-        const glm::ivec2 corners[3] = {{0, 0}, {r, 0}, {0, r}};
-        for (glm::ivec2 c : corners) {
-            uint32_t s = L.sampleAt(t, c.x, c.y);
-            glm::ivec2 texel = L.rhoTexel(t, c.x, c.y);
-            glm::vec3 p = L.position[s], nn = L.normal[s];
-            float v[8] = {p.x, p.y, p.z, nn.x, nn.y, nn.z, (texel.x + 0.5f) / rhoW,
-                          (texel.y + 0.5f) / rhoH};
-            vertices.insert(vertices.end(), v, v + 8);
-        }
+    for (const DrawCorner& c : drawCorners(L)) {
+        const float v[8] = {c.position.x, c.position.y, c.position.z, c.normal.x,
+                            c.normal.y,   c.normal.z,   c.uv.x,       c.uv.y};
+        vertices.insert(vertices.end(), v, v + 8);
     }
     rhoVertexCount = L.triangleCount * 3;
     glGenVertexArrays(1, &rhoVao);

@@ -79,8 +79,7 @@ protected:
         BaselineOptions o;
         o.method = m;
         o.loader = context_->loader();
-        const SurfaceLayout& L = b.data.layout;
-        auto baseline = Baseline::create(makeBake(b.data), normalDistances(*b.tracer, L.position, L.normal), o);
+        auto baseline = Baseline::create(makeBake(b.data), normalDistances(*b.tracer, b.data.layout), o);
         RenderedFrame f = renderFrame(*baseline, env, c, kSize, kSize);
         return makeEvalBuffer(kSize, kSize, f.color, f.directions);
     }

@@ -42,8 +42,9 @@ struct BaselineTimings {
 class Baseline {
 public:
     // Uploads the bake's mesh (its layout's triangle corners) in the current context. Wyman needs
-    // d_N, the distance along the inward normal to the far side, per bake sample (only triangle
-    // corners are read): compute it by ray casting, e.g. eval/reference.h normalDistances().
+    // d_N, the distance along the inward normal to the far side, per drawn point: per bake
+    // sample for a joining bake (only triangle corners are read), per chart vertex for a chart
+    // bake. Compute it by ray casting, e.g. eval/reference.h normalDistances().
     static std::unique_ptr<Baseline> create(const Bake& bake, const std::vector<float>& normalDistance,
                                             const BaselineOptions& options = {});
     ~Baseline();

@@ -3,7 +3,8 @@
 //                  [--exposure E] [--screenshot OUT.png --frames N] [--no-object]
 // Controls: left drag orbits, scroll zooms, Up/Down (or +/-) change the SH order used
 // (progressive decompression), S toggles smoothing, M cycles methods, T toggles per-stage
-// timings, P or F12 saves a screenshot, Esc quits. The title bar shows frame and stage times,
+// timings, G toggles the gutters and A seam-aware filling (chart bakes), P or F12 saves a
+// screenshot, Esc quits. The title bar shows frame and stage times,
 // which are also printed once a second. No GUI toolkit: the HUD is the title bar and stdout.
 #define GLFW_INCLUDE_NONE  // GL comes from the runtime's loader (gl.h), not GL/gl.h
 #include <GLFW/glfw3.h>
@@ -43,6 +44,7 @@ struct Viewer {
     double lastX = 0, lastY = 0;
     int order = 0, maxOrder = 0, method = 0;
     bool smoothing = false, timings = true, screenshot = false, quit = false;
+    bool gutters = true, seamAware = true;  // chart bakes: the bake's gutter rings, seam sources
 };
 
 
@@ -74,6 +76,8 @@ void onKey(GLFWwindow* window, int key, int, int action, int) {
         case GLFW_KEY_S: v.smoothing = !v.smoothing; break;
         case GLFW_KEY_M: v.method = (v.method + 1) % static_cast<int>(std::size(kMethods)); break;
         case GLFW_KEY_T: v.timings = !v.timings; break;
+        case GLFW_KEY_G: v.gutters = !v.gutters; break;
+        case GLFW_KEY_A: v.seamAware = !v.seamAware; break;
         case GLFW_KEY_P: case GLFW_KEY_F12: v.screenshot = true; break;
         default: break;
     }
@@ -213,11 +217,12 @@ int main(int argc, char** argv) {
         glfwSetMouseButtonCallback(window, onMouseButton);
         glfwSetCursorPosCallback(window, onCursor);
         glfwSetScrollCallback(window, onScroll);
-        std::printf("bake: order %d, %d samples, %d triangles; %.1f MB of GPU textures\n"
+        std::printf("bake: order %d, %d samples, %d triangles, %s layout; %.1f MB of GPU textures\n"
                     "keys: drag orbit, scroll zoom, Up/Down order, S smoothing, M method, "
-                    "T timings, P/F12 screenshot, Esc quit\n",
-                    bake.order(), bake.sampleCount(), bake.triangleCount(),
+                    "T timings, G gutters, A seam-aware (charts), P/F12 screenshot, Esc quit\n",
+                    bake.order(), bake.sampleCount(), bake.triangleCount(), bake.layout().c_str(),
                     refractor->memory().total() / 1e6);
+        const bool charts = bake.layout() != "joining";
 
         using Clock = std::chrono::steady_clock;
         auto last = Clock::now(), lastReport = last;
@@ -227,6 +232,8 @@ int main(int argc, char** argv) {
             if (v.order != refractor->order()) refractor->setOrder(v.order);
             refractor->setSmoothing(v.smoothing);
             refractor->setTimings(v.timings);
+            refractor->setGutter(v.gutters ? -1 : 0);
+            refractor->setSeamAware(v.seamAware);
 
             int fbw = 0, fbh = 0;
             glfwGetFramebufferSize(window, &fbw, &fbh);
@@ -262,13 +269,17 @@ int main(int argc, char** argv) {
             frameMs = std::chrono::duration<double, std::milli>(now - last).count();
             last = now;
             const shrefract::Timings& t = refractor->timings();
-            char title[256];
+            char chartState[64] = "";
+            if (charts)
+                std::snprintf(chartState, sizeof chartState, " gutter %d seam-aware %s",
+                              refractor->gutter(), refractor->seamAware() ? "on" : "off");
+            char title[320];
             std::snprintf(title, sizeof title,
-                          "shrefract-view | %s order %d (%d pass) smooth %s | %.1f ms/frame | "
-                          "view %.2f dec %.2f smooth %.2f unpack %.2f shade %.2f ms",
+                          "shrefract-view | %s order %d (%d pass) smooth %s%s | %.1f ms/frame | "
+                          "view %.2f dec %.2f smooth %.2f %s %.2f shade %.2f ms",
                           kMethods[v.method], refractor->order(), refractor->passCount(),
-                          v.smoothing ? "on" : "off", frameMs, t.view, t.decompress, t.smooth,
-                          t.unpack, t.shade);
+                          v.smoothing ? "on" : "off", chartState, frameMs, t.view, t.decompress,
+                          t.smooth, charts ? "gutters" : "unpack", t.unpack, t.shade);
             glfwSetWindowTitle(window, title);
             if (now - lastReport > std::chrono::seconds(1) || last_frame) {
                 // Stdout gets the title without its "shrefract-view | " prefix.

@@ -189,6 +189,12 @@ TEST_P(ChartGl, RenderCoversTheObject) {
     }
     EXPECT_GT(covered, 64u * 64u / 10);
     EXPECT_EQ(makeBake(data).layout(), "isolated");
+    // Chart bakes take their own path; the joining paths are refused for them.
+    EXPECT_EQ(r->path(), "charts");
+    RefractorOptions direct;
+    direct.loader = context_->loader();
+    direct.path = "direct";
+    EXPECT_THROW(Refractor::create(makeBake(data), direct), std::invalid_argument);
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, ChartGl, ::testing::Values(Backend::Egl, Backend::OSMesa),

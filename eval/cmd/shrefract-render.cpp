@@ -3,6 +3,7 @@
 //                    [--fov deg] [--size WxH] [--order L] [--backend egl|osmesa] [--out IMG.png]
 //                    [--out-exr IMG.exr] [--dirs EVAL.exr] [--dump-shaders DIR]
 //                    [--method sh|single|wyman|raytrace] [--wyman-tir reflect|straight|grazing]
+//                    [--ior N | --ior R,G,B [--ior-bracket BAKE2]]
 // A thin shell over the runtime library (shrefract/render.h, shrefract/baselines.h) and, for
 // raytrace and Wyman's d_N, the evaluation layer (eval/reference.h, Embree through bake/): the
 // runtime library itself never links the bake. Bad input: message, exit 1, and no output file.
@@ -60,6 +61,7 @@ int main(int argc, char** argv) {
     bool smoothing = false;
     std::string method = "sh", wymanTir = "reflect", scenePath;
     bool latLongLookup = false, noVerify = false;
+    std::string iorText, bracketPath;
     app.add_option("bake", bakePath, "NAME.shrefract.exr from shrefract-bake")->required();
     app.add_option("--env", envPath, "lat-long environment EXR")->required();
     app.add_option("--camera", camera, "orbit:AZ,EL,DIST (degrees, degrees, object units)");
@@ -94,6 +96,12 @@ int main(int argc, char** argv) {
     app.add_option("--scene", scenePath,
                    "raytrace, wyman: the baked mesh or scene, if not where the manifest says");
     app.add_option("--dump-shaders", dumpDir, "write the generated GLSL into DIR");
+    app.add_option("--ior", iorText,
+                   "index of refraction N, or one per channel R,G,B (dispersion): raytrace traces the "
+                   "scene's first part at it, sh interpolates (docs/runtime.md \"Variable IOR\")");
+    app.add_option("--ior-bracket", bracketPath,
+                   "sh with --ior: a second bake of the same mesh at another index, interpolated "
+                   "with BAKE per channel instead of the straight path");
     app.add_flag("--no-verify", noVerify, "skip the bake's checksums (faster; a corrupt file may draw garbage)");
     CLI11_PARSE(app, argc, argv);
 
@@ -128,6 +136,19 @@ int main(int argc, char** argv) {
         if (spp > 1 && method != "raytrace")
             throw std::invalid_argument("--spp " + std::to_string(spp) +
                                         ": only --method raytrace takes several samples per pixel");
+        glm::vec3 ior(0.0f);  // 0: the bake's own
+        if (!iorText.empty()) {
+            auto v = parseFloats(iorText, iorText.find(',') == std::string::npos ? 1 : 3, "--ior");
+            ior = v.size() == 1 ? glm::vec3(v[0]) : glm::vec3(v[0], v[1], v[2]);
+            if (glm::any(glm::lessThan(ior, glm::vec3(1.0f))) ||
+                glm::any(glm::greaterThan(ior, glm::vec3(5.0f))))
+                throw std::invalid_argument("--ior: every index must lie in [1, 5], got '" +
+                                            iorText + "'");
+            if (method != "sh" && method != "raytrace")
+                throw std::invalid_argument("--ior works with --method sh or raytrace");
+        }
+        if (!bracketPath.empty() && (iorText.empty() || method != "sh"))
+            throw std::invalid_argument("--ior-bracket needs --ior and --method sh");
 
         // Input first (cheap, and the common failure), then the context.
         shrefract::Bake bake = shrefract::loadBake(bakePath, !noVerify);
@@ -155,7 +176,26 @@ int main(int argc, char** argv) {
             view.fovDegrees = cam.fovDegrees, view.width = width, view.height = height;
             view.spp = spp;
             shrefract::ReferenceStats stats;
-            shrefract::EvalBuffer b = shrefract::renderReference(*tracer, envImage, view, &stats);
+            shrefract::EvalBuffer b;
+            if (ior.x > 0) {
+                // The first part (the object of a bare mesh) at each channel's index.
+                shrefract::EvalBuffer channel[3];
+                for (int c = 0; c < 3; ++c) {
+                    if (c > 0 && ior[c] == ior[c - 1]) {
+                        channel[c] = channel[c - 1];
+                        continue;
+                    }
+                    shrefract::Scene sc = *scene;
+                    sc.parts[0].medium.ior = ior[c];
+                    shrefract::Tracer t(sc, shrefract::traceOptionsOfBake(bake.data()));
+                    shrefract::ReferenceStats st;
+                    channel[c] = shrefract::renderReference(t, envImage, view, &st);
+                    if (c == 1 || stats.covered == 0) stats = st;
+                }
+                b = shrefract::composeChannels(channel[0], channel[1], channel[2]);
+            } else {
+                b = shrefract::renderReference(*tracer, envImage, view, &stats);
+            }
             frame.color.resize(b.pixelCount() * 4);
             frame.directions.resize(b.pixelCount() * 4);
             for (size_t i = 0; i < b.pixelCount(); ++i) {
@@ -182,9 +222,22 @@ int main(int argc, char** argv) {
                 options.preset = preset;
                 options.form = form;
                 options.order = order;
+                options.maxOrder = order;  // only the bands used go to the GPU (paper Figure 12)
                 options.smoothing = smoothing;
                 options.loader = context->loader();
                 auto refractor = shrefract::Refractor::create(bake, options);
+                std::unique_ptr<shrefract::Refractor> bracket;
+                if (ior.x > 0) {
+                    refractor->setIor(ior);
+                    if (!bracketPath.empty()) {
+                        bracket = shrefract::Refractor::create(
+                            shrefract::loadBake(bracketPath, !noVerify), options);
+                        refractor->setIorBracket(bracket.get());
+                    }
+                    std::printf("index of refraction %g,%g,%g from the bake's %g%s\n", ior.x, ior.y,
+                                ior.z, bake.ior(),
+                                bracket ? " and the bracketing bake's" : " and the straight path");
+                }
                 std::printf("bake: order %d, %d samples, %d triangles, rho %dx%d; using order %d, "
                             "%d decompression pass(es), preset %s\n",
                             bake.order(), bake.sampleCount(), bake.triangleCount(),
@@ -221,6 +274,11 @@ int main(int argc, char** argv) {
                     totals.push_back(x.view + x.decompress + x.smooth + x.unpack + x.shade);
                 msPerFrame = medianOf(totals);
                 stages = "GPU, sum of the stages";
+                if (bracket)
+                    std::printf("GPU memory: %.1f MB + bracketing bake %.1f MB\n",
+                                refractor->memory().total() / 1e6, bracket->memory().total() / 1e6);
+                else
+                    std::printf("GPU memory: %.1f MB\n", refractor->memory().total() / 1e6);
             } else {
                 shrefract::BaselineOptions options;
                 options.method = shrefract::parseBaselineMethod(method);

@@ -2,6 +2,7 @@
 bakes made once into a work folder and reused by every study, renders and their comparison.
 Python standard library only.
 """
+import glob
 import json
 import os
 import re
@@ -59,6 +60,23 @@ class Tools:
             json.dump(doc, f, indent=1)
         return out
 
+    def wait_for_other_baker(self, out):
+        """Another study running at the same time may be baking the same file: wait for that
+        shrefract-bake process (found by its -o OUT argument) rather than bake twice."""
+        while True:
+            pids = []
+            for entry in glob.glob("/proc/[0-9]*/cmdline"):
+                try:
+                    argv = open(entry, "rb").read().split(b"\0")
+                except OSError:
+                    continue
+                if any(a.endswith(b"shrefract-bake") for a in argv[:1]) and out.encode() in argv:
+                    pids.append(entry.split("/")[2])
+            if not pids:
+                return
+            self.log("waiting for process %s, which is baking %s" % (pids[0], os.path.basename(out)))
+            time.sleep(15)
+
     @staticmethod
     def own_ior(scene):
         """The index a scene is baked at without --ior: a JSON scene's first part's, else 1.5."""
@@ -74,6 +92,7 @@ class Tools:
         tag = name if ior is None else "%s_ior%g" % (name, ior)
         out = os.path.join(self.work, "bakes", tag + ".shrefract.exr")
         meta = out + ".json"
+        self.wait_for_other_baker(out)
         if os.path.exists(out) and not os.path.exists(meta):
             # Made by an earlier run that stopped before writing its notes (the bake itself is
             # written to a temporary name and renamed only when complete).

@@ -4,6 +4,7 @@ Python standard library only.
 """
 import glob
 import json
+import math
 import os
 import re
 import subprocess
@@ -147,8 +148,17 @@ class Tools:
 def summary(r):
     """The numbers a table shows of one comparison."""
     a = r["angleDeg"]
-    return {"median": a.get("median"), "p95": a.get("p95"), "mean": a.get("mean"),
-            "psnr": r["psnr"], "ssim": r["ssim"], "mismatch": r["coverage"]["mismatch"]}
+    out = {"median": a.get("median"), "p95": a.get("p95"), "mean": a.get("mean"),
+           "psnr": r["psnr"], "ssim": r["ssim"], "mismatch": r["coverage"]["mismatch"],
+           "covered": r["coverage"]["ref"]}
+    # PSNR over the object's pixels alone: the background is the same environment lookup in both
+    # (identical to 125 dB), so all the squared error lies on the object and
+    # MSE_object = MSE_frame * pixels / covered. The frame's PSNR also measures how much of the
+    # frame the object fills; this one does not.
+    pixels = r.get("pixels") or (r.get("width", 0) * r.get("height", 0))
+    if pixels and out["covered"]:
+        out["psnrObject"] = r["psnr"] - 10.0 * math.log10(pixels / out["covered"])
+    return out
 
 
 def write_section(name, owner, body):

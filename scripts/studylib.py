@@ -14,13 +14,15 @@ import time
 ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 
 
-def add_arguments(ap, size=384):
+def add_arguments(ap, size=384, spp=1):
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--work", default=None, help="bakes, renders, reports (default BUILD/studies)")
     ap.add_argument("--size", type=int, default=size)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--backend", default="egl")
     ap.add_argument("--frames", type=int, default=3)
+    ap.add_argument("--spp", type=int, default=spp,
+                    help="samples per pixel of the reference's colour (its directions: 1)")
 
 
 class Tools:
@@ -125,7 +127,8 @@ class Tools:
                          os.path.join(ROOT, "data", "envmaps", env + ".exr"), "--camera",
                          "orbit:" + camera, "--size", "%dx%d" % (size, size), "--method", method,
                          "--backend", self.args.backend, "--frames", str(self.args.frames),
-                         "--dirs", out] + list(extra))
+                         "--dirs", out] + list(extra) +
+                        (["--spp", str(self.args.spp)] if method == "raytrace" and self.args.spp > 1 else []))
         ms = re.search(r"ms per frame \(\w+\): ([0-9.]+)", text)
         mb = re.search(r"GPU memory: ([0-9.]+) MB(?: \+ bracketing bake ([0-9.]+) MB)?", text)
         memory = None
@@ -152,8 +155,8 @@ def summary(r):
            "psnr": r["psnr"], "ssim": r["ssim"], "mismatch": r["coverage"]["mismatch"],
            "covered": r["coverage"]["ref"]}
     # PSNR over the object's pixels alone: the background is the same environment lookup in both
-    # (identical to 125 dB), so all the squared error lies on the object and
-    # MSE_object = MSE_frame * pixels / covered. The frame's PSNR also measures how much of the
+    # (identical to 125 dB) except at a multi-sample reference's anti-aliased silhouette, so the
+    # squared error is the object's and MSE_object = MSE_frame * pixels / covered. The frame's PSNR also measures how much of the
     # frame the object fills; this one does not.
     pixels = r.get("pixels") or (r.get("width", 0) * r.get("height", 0))
     if pixels and out["covered"]:

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -30,7 +31,8 @@ Environment gradientEnvironment() {
     return Environment::fromLatLong(w, h, rgb);
 }
 
-class IorTest : public ::testing::Test {
+// Both interpolation paths: rho (the paper's refraction map) and direct (D per vertex).
+class IorTest : public ::testing::TestWithParam<const char*> {
 protected:
     void SetUp() override {
         try {
@@ -42,7 +44,10 @@ protected:
     std::unique_ptr<Refractor> refractor(const BakeData& d) {
         RefractorOptions o;
         o.loader = context_->loader();
-        return Refractor::create(makeBake(d), o);
+        o.path = GetParam();
+        auto r = Refractor::create(makeBake(d), o);
+        EXPECT_EQ(r->path(), GetParam());
+        return r;
     }
     RenderedFrame render(Refractor& r) {
         if (!env_) env_ = std::make_unique<Environment>(gradientEnvironment());  // this context's
@@ -72,7 +77,7 @@ float maxDifference(const RenderedFrame& a, const RenderedFrame& b, int c, size_
     return worst;
 }
 
-TEST_F(IorTest, AtTheBakesOwnIndexItIsThePlainShading) {
+TEST_P(IorTest, AtTheBakesOwnIndexItIsThePlainShading) {
     BakeData d = test::randomBake(4, 3);
     auto r = refractor(d);
     RenderedFrame plain = render(*r);
@@ -86,7 +91,7 @@ TEST_F(IorTest, AtTheBakesOwnIndexItIsThePlainShading) {
 }
 
 // Index 1 bends nothing: every exit is the primary ray through the pixel centre.
-TEST_F(IorTest, AtIndexOneTheExitIsTheStraightPath) {
+TEST_P(IorTest, AtIndexOneTheExitIsTheStraightPath) {
     BakeData d = test::randomBake(4, 3);
     auto r = refractor(d);
     r->setIor(glm::vec3(1.0f));
@@ -114,7 +119,7 @@ TEST_F(IorTest, AtIndexOneTheExitIsTheStraightPath) {
 }
 
 // Dispersion: each channel is shaded at its own index, independently of the others.
-TEST_F(IorTest, EachChannelIsShadedAtItsOwnIndex) {
+TEST_P(IorTest, EachChannelIsShadedAtItsOwnIndex) {
     BakeData d = test::randomBake(4, 3);
     auto r = refractor(d);
     r->setIor(glm::vec3(1.5f));
@@ -131,7 +136,7 @@ TEST_F(IorTest, EachChannelIsShadedAtItsOwnIndex) {
 }
 
 // Two bakes: at either bake's index, that bake's own shading.
-TEST_F(IorTest, BracketEndsAreTheTwoBakes) {
+TEST_P(IorTest, BracketEndsAreTheTwoBakes) {
     BakeData a = test::randomBake(4, 3, 7), b = test::randomBake(4, 3, 11);
     b.manifest["media"][0]["ior"] = 1.7;
     auto ra = refractor(a), rb = refractor(b);
@@ -149,7 +154,7 @@ TEST_F(IorTest, BracketEndsAreTheTwoBakes) {
     ra->setIorBracket(nullptr);
 }
 
-TEST_F(IorTest, BracketMustShareTheLayoutAndDifferInIndex) {
+TEST_P(IorTest, BracketMustShareTheLayoutAndDifferInIndex) {
     BakeData a = test::randomBake(4, 3, 7), other = test::randomBake(4, 2, 11), same = test::randomBake(4, 3, 11);
     other.manifest["media"][0]["ior"] = 1.7;
     auto ra = refractor(a), rOther = refractor(other), rSame = refractor(same);
@@ -157,6 +162,9 @@ TEST_F(IorTest, BracketMustShareTheLayoutAndDifferInIndex) {
     EXPECT_THROW(ra->setIorBracket(rSame.get()), std::invalid_argument);   // both at 1.5
     EXPECT_THROW(ra->setIor(glm::vec3(0.9f, 1.5f, 1.5f)), std::invalid_argument);
 }
+
+INSTANTIATE_TEST_SUITE_P(Paths, IorTest, ::testing::Values("direct", "rho"),
+                         [](const auto& info) { return std::string(info.param); });
 
 }  // namespace
 }  // namespace shrefract

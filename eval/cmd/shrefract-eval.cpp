@@ -3,6 +3,7 @@
 //   query BAKE --in Q.csv --out A.csv                        exit direction per (point, view)
 //   image --ref A.exr --test B.exr [--heatmap H.png] [--json R.json]   two evaluation buffers
 //   montage --out M.png IMG.exr... [--labels L...] [--errors]        labelled side by side
+//   compose R.exr G.exr B.exr --out D.exr    colour channel c of input c (dispersion)
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -12,6 +13,7 @@
 
 #include "eval/directions.h"
 #include "eval/image_eval.h"
+#include "eval/reference.h"
 #include "common/error.h"
 #include "common/sh.h"
 
@@ -115,6 +117,13 @@ int main(int argc, char** argv) {
     mont->add_flag("--errors", withErrors, "a second row: angular error heat maps against the first input");
     mont->add_option("--max-deg", maxDeg, "heat map: degrees at the top of the ramp")->capture_default_str();
     mont->add_option("--exposure", exposure, "exposure before the tone map")->capture_default_str();
+    std::vector<std::string> channels;
+    std::string composed;
+    auto* compose = app.add_subcommand(
+        "compose", "one evaluation buffer from three: colour channel c of input c, coverage and "
+                   "directions of the second (three grey renders at one index per channel)");
+    compose->add_option("inputs", channels, "R.exr G.exr B.exr")->required()->expected(3);
+    compose->add_option("--out", composed, "evaluation buffer EXR")->required();
     CLI11_PARSE(app, argc, argv);
 
     try {
@@ -137,6 +146,13 @@ int main(int argc, char** argv) {
             std::printf("tone-mapped: PSNR %.2f dB, SSIM %.4f\n", r["psnr"].get<double>(), r["ssim"].get<double>());
             if (!heatPath.empty()) writePng8(heatPath, heatMap(ref, test, maxDeg, exposure));
             if (!jsonPath.empty()) writeAtomically(jsonPath, r.dump(2) + "\n");
+            return 0;
+        }
+        if (compose->parsed()) {
+            writeEvalBuffer(composed, composeChannels(readEvalBuffer(channels[0]),
+                                                      readEvalBuffer(channels[1]),
+                                                      readEvalBuffer(channels[2])));
+            std::printf("composed -> %s\n", composed.c_str());
             return 0;
         }
         if (mont->parsed()) {

@@ -80,6 +80,7 @@ int main(int argc, char** argv) {
     bool smoothing = false;
     std::string method = "sh", wymanTir = "reflect", scenePath, absorption, flicker, flickerJson;
     bool latLongLookup = false, noVerify = false;
+    std::string iorText, bracketPath;
     RefractorOptions sh;  // defaults shown in --help
     app.add_option("bake", bakePath, "NAME.shrefract.exr from shrefract-bake")->required();
     app.add_option("--env", envPath, "lat-long environment EXR")->required();
@@ -135,6 +136,12 @@ int main(int argc, char** argv) {
                    "report the mean absolute difference of consecutive tone-mapped frames");
     app.add_option("--flicker-json", flickerJson, "write the --flicker result here");
     app.add_option("--dump-shaders", dumpDir, "write the generated GLSL into DIR");
+    app.add_option("--ior", iorText,
+                   "index of refraction N, or one per channel R,G,B (dispersion): raytrace traces the "
+                   "scene's first part at it, sh interpolates (docs/runtime.md \"Variable IOR\")");
+    app.add_option("--ior-bracket", bracketPath,
+                   "sh with --ior: a second bake of the same mesh at another index, interpolated "
+                   "with BAKE per channel instead of the straight path");
     app.add_flag("--no-verify", noVerify, "skip the bake's checksums (faster; a corrupt file may draw garbage)");
     CLI11_PARSE(app, argc, argv);
 
@@ -177,6 +184,20 @@ int main(int argc, char** argv) {
             throw std::invalid_argument("--spp " + std::to_string(spp) +
                                         ": only --method raytrace takes several samples per pixel");
 
+        glm::vec3 ior(0.0f);  // 0: the bake's own
+        if (!iorText.empty()) {
+            auto v = parseFloats(iorText, iorText.find(',') == std::string::npos ? 1 : 3, "--ior");
+            ior = v.size() == 1 ? glm::vec3(v[0]) : glm::vec3(v[0], v[1], v[2]);
+            if (glm::any(glm::lessThan(ior, glm::vec3(1.0f))) ||
+                glm::any(glm::greaterThan(ior, glm::vec3(5.0f))))
+                throw std::invalid_argument("--ior: every index must lie in [1, 5], got '" +
+                                            iorText + "'");
+            if (method != "sh" && method != "raytrace")
+                throw std::invalid_argument("--ior works with --method sh or raytrace");
+        }
+        if (!bracketPath.empty() && (iorText.empty() || method != "sh"))
+            throw std::invalid_argument("--ior-bracket needs --ior and --method sh");
+
         // Input first (cheap, and the common failure), then the context.
         Bake bake = loadBake(bakePath, !noVerify);
         for (const std::string& w : bake.warnings())
@@ -208,7 +229,7 @@ int main(int argc, char** argv) {
         std::unique_ptr<ReferenceEnvironment> envImage;
         std::unique_ptr<HeadlessContext> context;
         std::unique_ptr<Environment> env;
-        std::unique_ptr<Refractor> refractor;
+        std::unique_ptr<Refractor> refractor, bracket;
         std::unique_ptr<Baseline> baseline;
         if (method == "raytrace") {
             // The CPU reference: no GL context at all.
@@ -220,7 +241,26 @@ int main(int argc, char** argv) {
                 view.fovDegrees = c.fovDegrees, view.width = width, view.height = height;
                 view.spp = spp;
                 ReferenceStats stats;
-                const EvalBuffer b = renderReference(*tracer, *envImage, view, &stats);
+                EvalBuffer b;
+                if (ior.x > 0) {
+                    // The first part (the object of a bare mesh) at each channel's index.
+                    EvalBuffer channel[3];
+                    for (int ch = 0; ch < 3; ++ch) {
+                        if (ch > 0 && ior[ch] == ior[ch - 1]) {
+                            channel[ch] = channel[ch - 1];
+                            continue;
+                        }
+                        Scene sc = *scene;
+                        sc.parts[0].medium.ior = ior[ch];
+                        Tracer t(sc, traceOptionsOfBake(bake.data()));
+                        ReferenceStats st;
+                        channel[ch] = renderReference(t, *envImage, view, &st);
+                        if (ch == 1 || stats.covered == 0) stats = st;
+                    }
+                    b = composeChannels(channel[0], channel[1], channel[2]);
+                } else {
+                    b = renderReference(*tracer, *envImage, view, &stats);
+                }
                 RenderedFrame f;
                 f.width = width, f.height = height;
                 f.color.resize(b.pixelCount() * 4);
@@ -249,9 +289,20 @@ int main(int argc, char** argv) {
                 options.preset = preset;
                 options.form = form;
                 options.order = order;
+                options.maxOrder = order;  // only the bands used go to the GPU (paper Figure 12)
                 options.smoothing = smoothing;
                 options.loader = context->loader();
                 refractor = Refractor::create(bake, options);
+                if (ior.x > 0) {
+                    refractor->setIor(ior);
+                    if (!bracketPath.empty()) {
+                        bracket = Refractor::create(loadBake(bracketPath, !noVerify), options);
+                        refractor->setIorBracket(bracket.get());
+                    }
+                    std::printf("index of refraction %g,%g,%g from the bake's %g%s\n", ior.x, ior.y,
+                                ior.z, bake.ior(),
+                                bracket ? " and the bracketing bake's" : " and the straight path");
+                }
                 std::printf("bake: order %d, %d samples, %d triangles, rho %dx%d; using order %d, "
                             "%d decompression pass(es), preset %s, path %s, decompression %s, "
                             "shading %s; GPU memory %.2f MB\n",
@@ -332,6 +383,11 @@ int main(int argc, char** argv) {
                 std::printf("GPU ms: view %.3f, decompress %.3f (%d passes), smooth %.3f, unpack "
                             "%.3f, shade %.3f\n",
                             t.view, t.decompress, t.passes, t.smooth, t.unpack, t.shade);
+                if (bracket)
+                    std::printf("GPU memory: %.1f MB + bracketing bake %.1f MB\n",
+                                refractor->memory().total() / 1e6, bracket->memory().total() / 1e6);
+                else
+                    std::printf("GPU memory: %.1f MB\n", refractor->memory().total() / 1e6);
             } else if (baseline) {
                 std::printf("GPU ms: back faces %.3f, shade %.3f\n", baseline->timings().backFaces,
                             baseline->timings().shade);

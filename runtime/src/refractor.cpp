@@ -18,6 +18,7 @@
 #include "common/sh.h"
 #include "environment_gl.h"
 #include "gl.h"
+#include "ior.h"
 #include "shadergen.h"
 #include "shaders.h"
 #include "shrefract/runtime.h"
@@ -118,6 +119,7 @@ struct Refractor::Impl {
     GLuint lastD = 0;            // texture holding the D_mu fed to unpack or to the direct shading
     bool rhoReady = false;       // the rho target holds the map for the last update()
     glm::vec3 lastEye{0, 0, 3};  // object space, of the last update()
+    IorShading ior;              // setIor(): shading at other indices (runtime/src/ior.h)
 
     void use() const { ensureLoaded(loader); }
     const Compiled& compiledFor(int L);
@@ -494,6 +496,7 @@ Refractor::~Refractor() {
     for (GLuint p : {m.viewProgram, m.smoothProgram, m.unpackProgram, m.shadeRhoProgram,
                      m.shadeDirectProgram})
         if (p) glDeleteProgram(p);
+    m.ior.destroy();
     GLuint textures[] = {m.positionTex, m.normalTex, m.weightArray, m.rhoIndexTex,
                          m.rangeTex,    m.nbrIndexTex, m.nbrWeightTex};
     for (GLuint t : textures)
@@ -625,6 +628,21 @@ void Refractor::update(glm::vec3 eye, const glm::mat4& model) {
         if (!m.direct) m.unpackRho(true);
         else if (m.rhoIndexTex) m.unpackRho(false);
     }
+    if (m.ior.active) {
+        // Shading at other indices (runtime/src/ior.h) reads D_mu from a texture on the direct
+        // path, and the bracketing bake's D for the same view; its stages count in this frame's.
+        if (m.direct && m.vertexMode()) m.decompressInTextureSpace(true);
+        if (Refractor* other = m.ior.bracket) {
+            other->update(eye, model);
+            Impl& b = *other->impl_;
+            if (m.direct && b.vertexMode()) b.decompressInTextureSpace(false);
+            m.ior.bracketD = m.direct ? b.lastD : other->refractionMap();
+            m.timings.view += b.timings.view, m.timings.decompress += b.timings.decompress;
+            m.timings.smooth += b.timings.smooth, m.timings.unpack += b.timings.unpack;
+            m.timings.passes += b.timings.passes;
+            m.use();
+        }
+    }
     glUseProgram(0);
     glBindVertexArray(0);
     glActiveTexture(GL_TEXTURE0);
@@ -640,8 +658,10 @@ void Refractor::draw(const glm::mat4& view, const glm::mat4& projection, const g
     m.begin(kShade);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
-    GLuint p = !m.direct          ? m.shadeRhoProgram
-               : m.vertexMode()   ? m.compiledFor(m.order).shadeVertexSh
+    const bool vertexSh = m.vertexMode() && !m.ior.active;
+    GLuint p = m.ior.active       ? m.ior.program(m.direct, m.muW)
+               : !m.direct        ? m.shadeRhoProgram
+               : vertexSh         ? m.compiledFor(m.order).shadeVertexSh
                                   : m.directTextureProgram();
     glUseProgram(p);
     glm::mat4 vp = projection * view;
@@ -664,11 +684,13 @@ void Refractor::draw(const glm::mat4& view, const glm::mat4& projection, const g
     setFloat(p, "uSpreadScale", m.options.spreadScale);
     setFloat(p, "uFootprintScale", m.options.footprintScale);
     useEnvironment(p, environment, 0);
+    if (m.ior.active)
+        m.ior.setUniforms(p, m.bake.ior(), m.ior.bracket ? m.ior.bracket->impl_->bake.ior() : 0.0f);
     if (m.direct) {
         bindTexture(1, GL_TEXTURE_2D, m.lastD);
         bindTexture(2, GL_TEXTURE_2D, m.positionTex);
         bindTexture(3, GL_TEXTURE_2D, m.normalTex);
-        if (m.vertexMode()) {
+        if (vertexSh) {
             // Eye in object space, and the weights from unit 4 on (compiledFor's assignment).
             const glm::vec3 e = glm::vec3(glm::inverse(model) * glm::vec4(eye, 1.0f));
             glUniform3f(glGetUniformLocation(p, "uEyeObject"), e.x, e.y, e.z);
@@ -704,6 +726,32 @@ unsigned Refractor::refractionMap() {
         glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
     }
     return m.rho.texture;
+}
+
+void Refractor::setIor(glm::vec3 ior) {
+    if (!(glm::all(glm::greaterThanEqual(ior, glm::vec3(1.0f))) &&
+          glm::all(glm::lessThanEqual(ior, glm::vec3(5.0f)))))
+        throw std::invalid_argument("shrefract: setIor: every index must lie in [1, 5]");
+    impl_->ior.active = true;
+    impl_->ior.ior = ior;
+}
+
+void Refractor::resetIor() { impl_->ior.active = false; }
+
+void Refractor::setIorBracket(Refractor* other) {
+    if (other) {
+        const SurfaceLayout &a = impl_->bake.data().layout, &b = other->impl_->bake.data().layout;
+        if (other == this || a.sampleCount() != b.sampleCount() ||
+            a.triangleCount != b.triangleCount || a.rate != b.rate ||
+            a.muWidth != b.muWidth || a.rhoWidth != b.rhoWidth || a.rhoHeight != b.rhoHeight)
+            throw std::invalid_argument(
+                "shrefract: setIorBracket: the bracketing bake must have this bake's layout (same "
+                "mesh and rate)");
+        if (other->impl_->bake.ior() == impl_->bake.ior())
+            throw std::invalid_argument(
+                "shrefract: setIorBracket: the bracketing bake has this bake's index of refraction");
+    }
+    impl_->ior.bracket = other;
 }
 
 glm::ivec2 Refractor::refractionMapSize() const { return {impl_->rhoW, impl_->rhoH}; }

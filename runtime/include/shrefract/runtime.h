@@ -155,6 +155,17 @@ public:
     int order() const;
     void setSmoothing(bool on);
     void setCorrection(bool on);  // off only to show the seams it removes
+    // Shades as if the object had index `ior` per RGB channel (different: dispersion), each in
+    // [1, 5] (docs/runtime.md "Variable IOR and dispersion"). With one bake each channel's exit
+    // interpolates between the straight path (index 1) and the baked one, the paper's §5.4
+    // (which has no physical basis); with setIorBracket, between two bakes.
+    void setIor(glm::vec3 ior);
+    void resetIor();  // back to the bake's own index
+    // A bake of the same mesh and layout at another index, interpolated with this one per
+    // channel for setIor(); update() updates it too (its stage times add to timings()). It must
+    // outlive this refractor or be unset (nullptr). Throws std::invalid_argument if the layouts
+    // differ or the index is the same.
+    void setIorBracket(Refractor* other);
     // GL timer queries per stage (RefractorOptions::timings); off zeroes timings().
     void setTimings(bool on);
     const Timings& timings() const;

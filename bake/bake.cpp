@@ -122,6 +122,30 @@ BakeResult bake(const Scene& scene, const BakeOptions& opt, const std::string& i
                 for (int j = 0; j < J; ++j) {
                     const glm::vec3 omega = frame.fromLocal(dirs[j]);
                     PathResult p = tracer.trace(L.position[i], L.normal[i], omega, L.part[i]);
+                    if (opt.footprintSamples > 1) {
+                        // The mean over the footprint: points along the segments to the grid
+                        // neighbours (listed after the sample itself), spread evenly over them,
+                        // at a quarter and two fifths of the way.
+                        const uint32_t first = L.neighbourOffset[i] + 1, others = L.neighbourCount[i] - 1;
+                        const uint32_t extra = uint32_t(opt.footprintSamples - 1);
+                        glm::vec3 sumExit = p.exit;
+                        float sumLength = p.length;
+                        int used = 1;
+                        for (int f = 1; f < opt.footprintSamples && others > 0; ++f) {
+                            const uint32_t nb = L.neighbourIndex[first + (uint32_t(f - 1) * others) / extra];
+                            const float t = f % 2 ? 0.25f : 0.4f;
+                            const glm::vec3 pf = glm::mix(L.position[i], L.position[nb], t);
+                            const glm::vec3 nf = glm::normalize(glm::mix(L.normal[i], L.normal[nb], t));
+                            if (glm::dot(nf, omega) <= 0.0f) continue;  // the view is below it there
+                            const PathResult q = tracer.trace(pf, nf, omega, L.part[i]);
+                            sumExit += q.exit;
+                            sumLength += q.length;
+                            localRays += q.rays;
+                            ++used;
+                        }
+                        p.exit = sumExit / float(used);
+                        p.length = sumLength / float(used);
+                    }
                     if (weighted) paths[s * J + j] = p;
                     R(j, 4 * s + 0) = p.exit.x;
                     R(j, 4 * s + 1) = p.exit.y;

@@ -81,8 +81,13 @@ void WeightedFitter::confidence(const PathResult* paths, float* c) const {
         for (int k = 0; k < nP; ++k) {
             const int j = i * nP + k;
             const int right = i * nP + (k + 1) % nP, up = (i + 1) * nP + k;
-            if (glm::dot(paths[j].exit, paths[right].exit) < cosMax) lower(j), lower(right);
-            if (i + 1 < nT && glm::dot(paths[j].exit, paths[up].exit) < cosMax) lower(j), lower(up);
+            // Exits may be footprint means (shorter than 1): compare their directions.
+            auto turns = [&](int a, int b) {
+                const glm::vec3 ea = paths[a].exit, eb = paths[b].exit;
+                return glm::dot(ea, eb) < cosMax * glm::length(ea) * glm::length(eb);
+            };
+            if (turns(j, right)) lower(j), lower(right);
+            if (i + 1 < nT && turns(j, up)) lower(j), lower(up);
         }
 }
 

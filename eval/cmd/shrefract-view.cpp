@@ -262,14 +262,22 @@ int main(int argc, char** argv) {
             auto now = Clock::now();
             frameMs = std::chrono::duration<double, std::milli>(now - last).count();
             last = now;
-            const shrefract::Timings& t = refractor->timings();
             char title[256];
-            std::snprintf(title, sizeof title,
-                          "shrefract-view | %s order %d (%d pass) smooth %s | %.1f ms/frame | "
-                          "view %.2f dec %.2f smooth %.2f unpack %.2f shade %.2f ms",
-                          kMethods[v.method], refractor->order(), refractor->passCount(),
-                          v.smoothing ? "on" : "off", frameMs, t.view, t.decompress, t.smooth,
-                          t.unpack, t.shade);
+            if (sh) {
+                const shrefract::Timings& t = refractor->timings();
+                std::snprintf(title, sizeof title,
+                              "shrefract-view | sh order %d (%s, %d pass) smooth %s | %.1f ms/frame | "
+                              "view %.2f dec %.2f smooth %.2f unpack %.2f shade %.2f ms",
+                              refractor->order(), refractor->path().c_str(), refractor->passCount(),
+                              v.smoothing ? "on" : "off", frameMs, t.view, t.decompress, t.smooth,
+                              t.unpack, t.shade);
+            } else {
+                // The baselines have no SH order and no SH stages: only their own passes.
+                const shrefract::BaselineTimings& t = baselines[v.method - 1]->timings();
+                std::snprintf(title, sizeof title,
+                              "shrefract-view | %s | %.1f ms/frame | back faces %.2f shade %.2f ms",
+                              kMethods[v.method], frameMs, t.backFaces, t.shade);
+            }
             glfwSetWindowTitle(window, title);
             if (now - lastReport > std::chrono::seconds(1) || last_frame) {
                 // Stdout gets the title without its "shrefract-view | " prefix.

@@ -22,6 +22,23 @@ const BakeData& Bake::data() const {
 }
 int Bake::order() const { return data().order; }
 const std::vector<std::string>& Bake::warnings() const { return data().warnings; }
+
+std::vector<MapVertex> Bake::refractionMapMesh() const {
+    // Triangle t's corners are its grid samples (0,0), (r,0), (0,r); their uv the rho texel
+    // centres (docs/format.md "rho").
+    const SurfaceLayout& L = data().layout;
+    const int r = L.rate;
+    std::vector<MapVertex> out;
+    out.reserve(static_cast<size_t>(L.triangleCount) * 3);
+    for (int t = 0; t < L.triangleCount; ++t)
+        for (glm::ivec2 c : {glm::ivec2(0, 0), glm::ivec2(r, 0), glm::ivec2(0, r)}) {
+            const uint32_t s = L.sampleAt(t, c.x, c.y);
+            const glm::ivec2 texel = L.rhoTexel(t, c.x, c.y);
+            out.push_back({L.position[s], L.normal[s],
+                           glm::vec2((texel.x + 0.5f) / L.rhoWidth, (texel.y + 0.5f) / L.rhoHeight)});
+        }
+    return out;
+}
 int Bake::sampleCount() const { return data().layout.sampleCount(); }
 int Bake::triangleCount() const { return data().layout.triangleCount; }
 

@@ -447,31 +447,18 @@ void Refractor::Impl::ensureRhoResources() {
 // The rho path's shading: its program and the mesh rebuilt from rho and the samples: triangle
 // t's corners are its grid samples (0,0), (r,0), (0,r); UVs point at their texel centres in rho.
 void Refractor::Impl::buildRhoMesh() {
-    const SurfaceLayout& L = bake.data().layout;
     shadeRhoProgram = buildProgram(shaders::source("shade.vert"), shaders::source("shade.frag"), "shading");
     glUseProgram(shadeRhoProgram);
     setInt(shadeRhoProgram, "uRho", 1);
     glUseProgram(0);
-    const int r = L.rate;
-    std::vector<float> vertices;
-    vertices.reserve(static_cast<size_t>(L.triangleCount) * 3 * 8);
-    for (int t = 0; t < L.triangleCount; ++t) {
-        const glm::ivec2 corners[3] = {{0, 0}, {r, 0}, {0, r}};
-        for (glm::ivec2 c : corners) {
-            uint32_t s = L.sampleAt(t, c.x, c.y);
-            glm::ivec2 texel = L.rhoTexel(t, c.x, c.y);
-            glm::vec3 p = L.position[s], nn = L.normal[s];
-            float v[8] = {p.x, p.y, p.z, nn.x, nn.y, nn.z, (texel.x + 0.5f) / rhoW,
-                          (texel.y + 0.5f) / rhoH};
-            vertices.insert(vertices.end(), v, v + 8);
-        }
-    }
-    rhoVertexCount = L.triangleCount * 3;
+    static_assert(sizeof(MapVertex) == 8 * sizeof(float));
+    const std::vector<MapVertex> vertices = bake.refractionMapMesh();
+    rhoVertexCount = static_cast<int>(vertices.size());
     glGenVertexArrays(1, &rhoVao);
     glBindVertexArray(rhoVao);
     glGenBuffers(1, &rhoVbo);
     glBindBuffer(GL_ARRAY_BUFFER, rhoVbo);
-    glBufferData(GL_ARRAY_BUFFER, vertices.size() * sizeof(float), vertices.data(), GL_STATIC_DRAW);
+    glBufferData(GL_ARRAY_BUFFER, vertices.size() * sizeof(MapVertex), vertices.data(), GL_STATIC_DRAW);
     for (int a = 0; a < 3; ++a) glEnableVertexAttribArray(a);
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 8 * sizeof(float), nullptr);
     glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 8 * sizeof(float),
@@ -479,7 +466,7 @@ void Refractor::Impl::buildRhoMesh() {
     glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, 8 * sizeof(float),
                           reinterpret_cast<void*>(6 * sizeof(float)));
     glBindVertexArray(0);
-    memory.mesh = vertices.size() * sizeof(float);
+    memory.mesh = vertices.size() * sizeof(MapVertex);
 }
 
 Refractor::~Refractor() {

@@ -14,6 +14,13 @@ namespace shrefract {
 
 struct BakeData;  // common/bakefile.h
 
+// A vertex of the mesh the refraction map is laid out for (Bake::refractionMapMesh).
+struct MapVertex {
+    glm::vec3 position;  // object space
+    glm::vec3 normal;    // unit shading normal, object space
+    glm::vec2 uv;        // refraction-map texture coordinate (the rho layout), texel centres
+};
+
 // A loaded bake, cheap to copy (shared, immutable).
 class Bake {
 public:
@@ -25,6 +32,10 @@ public:
     // What loading noticed that the app should show its user, e.g. an older format version
     // whose data cannot be verified.
     const std::vector<std::string>& warnings() const;
+    // The mesh refractionMap() is laid out for, three vertices per triangle (no index buffer):
+    // an app that shades the glass in its own material draws these and samples the map at uv
+    // (docs/integrate.md).
+    std::vector<MapVertex> refractionMapMesh() const;
     const BakeData& data() const;
 
 private:

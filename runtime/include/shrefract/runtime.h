@@ -136,6 +136,9 @@ struct RefractorOptions {
     // "sharp": the paper's single lookup along the exit direction (docs/runtime.md).
     std::string shading = "spread";
     float spreadScale = 1.0f;       // lobe width factor (spread shading)
+    // The reconstruction length counted as fully coherent (spread shading): the SH of even a
+    // smooth mapping come out a little short, and their length is divided by this first.
+    float spreadFull = 1.0f;
     float footprintScale = 0.5f;    // screen-space footprint factor (spread shading)
     bool timings = true;            // GL timer queries around every stage
     bool toneMap = false;           // draw() writes display values (toneMap()) instead of HDR

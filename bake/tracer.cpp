@@ -50,13 +50,11 @@ struct MediaStack {
     void add(uint32_t p) {
         if (!contains(p) && n < kMax) part[n++] = p;
     }
-    void remove(uint32_t p) {
+    void remove(uint32_t p) {  // keeps the order of the others (ties: most recently entered)
+        int kept = 0;
         for (int i = 0; i < n; ++i)
-            if (part[i] == p) {
-                for (int k = i; k + 1 < n; ++k) part[k] = part[k + 1];
-                --n;
-                return;
-            }
+            if (part[i] != p) part[kept++] = part[i];
+        n = kept;
     }
     // Index of the part in effect, or -1 for air.
     int top(const Scene& s) const {
@@ -70,8 +68,8 @@ struct MediaStack {
 
 float iorOf(const Scene& s, int part) { return part < 0 ? 1.0f : float(s.parts[part].medium.ior); }
 
-// One closest-hit query from org along dir, t in [0, inf).
-RTCRayHit closestHit(RTCScene scene, RTCIntersectContext* ctx, glm::vec3 org, glm::vec3 dir) {
+// A ray from org along dir, t in [0, inf), not yet traced.
+RTCRayHit ray(glm::vec3 org, glm::vec3 dir) {
     RTCRayHit rh;
     rh.ray.org_x = org.x, rh.ray.org_y = org.y, rh.ray.org_z = org.z;
     rh.ray.dir_x = dir.x, rh.ray.dir_y = dir.y, rh.ray.dir_z = dir.z;
@@ -80,6 +78,12 @@ RTCRayHit closestHit(RTCScene scene, RTCIntersectContext* ctx, glm::vec3 org, gl
     rh.ray.mask = 0xFFFFFFFF;
     rh.ray.flags = 0;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    return rh;
+}
+
+// One closest-hit query from org along dir.
+RTCRayHit closestHit(RTCScene scene, RTCIntersectContext* ctx, glm::vec3 org, glm::vec3 dir) {
+    RTCRayHit rh = ray(org, dir);
     rtcIntersect1(scene, ctx, &rh);
     return rh;
 }
@@ -157,111 +161,169 @@ bool Tracer::hit(glm::vec3 org, glm::vec3 dir, SurfaceHit* out) const {
     return true;
 }
 
-PathResult Tracer::trace(glm::vec3 p, glm::vec3 n, glm::vec3 omega, uint32_t part,
-                         std::vector<LoggedRay>* log) const {
+// One path in flight: where its next segment starts and what it has met so far.
+struct Tracer::Path {
+    glm::vec3 org, d;  // the next segment: origin (offset off the surface) and unit direction
+    glm::vec3 from;    // the surface point that segment leaves: lengths are measured between
+                       // true surface points, not from offset origins
+    MediaStack media;
     PathResult res;
+};
+
+// Rule 1: the first interface transmits (the primary reflection is the runtime's). Returns false
+// when the path has already ended (an "optically thinner than air" medium reflects at once).
+bool Tracer::start(glm::vec3 p, glm::vec3 n, glm::vec3 omega, uint32_t part, Path* path) const {
+    const Scene& s = scene_;
+    path->res = PathResult{};
+    path->media = MediaStack{};
+    path->media.add(part);
+    glm::vec3 d;
+    if (!Refract(omega, n, iorOf(s, path->media.top(s)) / 1.0f, &d)) {
+        path->res.exit = Reflect(omega, n);
+        path->res.flags |= kPathTIR;
+        return false;
+    }
+    path->org = p - n * epsilon_;
+    path->d = d;
+    path->from = p;
+    return true;
+}
+
+// What the segment from path->org along path->d met (Embree's answer in `rh`): the interface
+// event of rules 2-6. Returns false when the path has ended (path->res is then final).
+bool Tracer::advance(Path* path, const ::RTCRayHit& rh) const {
     const Scene& s = scene_;
     const float eps = epsilon_;
     const int cap = options_.maxBounces;
+    PathResult& res = path->res;
+    MediaStack& media = path->media;
+    glm::vec3& d = path->d;
+    ++res.rays;
 
-    // Rule 1: the first interface transmits (the primary reflection is the runtime's).
-    MediaStack media;
-    media.add(part);
-    glm::vec3 d;
-    if (!Refract(omega, n, iorOf(s, media.top(s)) / 1.0f, &d)) {
-        // Only an "optically thinner than air" medium can do this; it reflects, and leaves.
-        res.exit = Reflect(omega, n);
-        res.flags |= kPathTIR;
-        return res;
+    const int before = media.top(s);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+        // Rule 4: the direction that finally escapes to infinity.
+        if (media.n > 0) res.flags |= kPathLeaked;
+        res.exit = d;
+        return false;
     }
-    glm::vec3 org = p - n * eps;
-    glm::vec3 from = p;  // the surface point this segment started at: lengths are measured
-                         // between true surface points, not from offset origins
+    const SurfaceHit h = surfaceAt(rh);
+    const uint32_t q = h.part;
+    const glm::vec3 hitP = h.p, ng = h.ng, ns = h.ns;
+    // Rule 6: length inside non-air media.
+    if (before >= 0) res.length += glm::length(hitP - path->from);
+    path->from = hitP;
 
+    const bool entering = glm::dot(d, ng) < 0.0f;
+    if (entering && media.n == 0) res.flags |= kPathReentered;  // it had left: rule 4
+    MediaStack next = media;
+    if (entering) next.add(q); else next.remove(q);
+    const int after = next.top(s);
+
+    if (after == before) {
+        // A boundary inside a medium of higher priority: not an interface, go straight on.
+        media = next;
+        path->org = hitP + d * eps;
+        return true;
+    }
+    // Normals facing the side the ray comes from.
+    const glm::vec3 ngf = entering ? ng : -ng;
+    glm::vec3 nf = entering ? ns : -ns;
+    const glm::vec3 wi = -d;
+    // Rule 3: a shading normal that faces away from the incoming ray cannot be used.
+    if (glm::dot(nf, wi) <= 0.0f) {
+        nf = ngf;
+        res.flags |= kPathGeometricNormal;
+    }
+    const float eta = iorOf(s, after) / iorOf(s, before);
+    glm::vec3 wt;
+    bool canTransmit = Refract(wi, nf, eta, &wt);
+    if (canTransmit && glm::dot(wt, ngf) >= 0.0f) {
+        // Rule 3: refracted onto the wrong side of the true surface: redo about Ng.
+        res.flags |= kPathGeometricNormal;
+        nf = ngf;
+        canTransmit = Refract(wi, nf, eta, &wt);
+    }
+    bool reflect;
+    if (!canTransmit) {
+        reflect = true;  // Rule 2: total internal reflection
+        res.flags |= kPathTIR;
+    } else if (options_.branch == Branch::Transmit) {
+        reflect = false;
+    } else {
+        const bool larger = FresnelDielectric(glm::dot(wi, nf), eta) > 0.5f;
+        // Rule 5: past half the cap, take the transmitted branch whenever it exists, so
+        // every path ends deterministically.
+        reflect = larger && res.bounces < cap / 2;  // else the larger branch
+        if (larger && !reflect) res.flags |= kPathSoftCapped;
+    }
+    if (reflect) {
+        d = Reflect(wi, nf);
+        if (glm::dot(d, ngf) <= 0.0f) {
+            res.flags |= kPathGeometricNormal;
+            d = Reflect(wi, ngf);
+        }
+        path->org = hitP + ngf * eps;
+    } else {
+        d = wt;
+        media = next;
+        path->org = hitP - ngf * eps;
+    }
+    d = glm::normalize(d);
+    ++res.bounces;
+    if (res.bounces >= cap) {
+        // Rule 5: the hard cap. The path ends here, along its current direction.
+        res.flags |= kPathCapped;
+        res.exit = d;
+        return false;
+    }
+    return true;
+}
+
+PathResult Tracer::trace(glm::vec3 p, glm::vec3 n, glm::vec3 omega, uint32_t part,
+                         std::vector<LoggedRay>* log) const {
+    Path path;
+    if (!start(p, n, omega, part, &path)) return path.res;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     for (;;) {
-        const RTCRayHit rh = closestHit(rtc_->scene, &ctx, org, d);
-        if (log) log->push_back({org, d});
-        ++res.rays;
+        const RTCRayHit rh = closestHit(rtc_->scene, &ctx, path.org, path.d);
+        if (log) log->push_back({path.org, path.d});
+        if (!advance(&path, rh)) return path.res;
+    }
+}
 
-        const int before = media.top(s);
-        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
-            // Rule 4: the direction that finally escapes to infinity.
-            if (media.n > 0) res.flags |= kPathLeaked;
-            res.exit = d;
-            return res;
-        }
-        const SurfaceHit h = surfaceAt(rh);
-        const uint32_t q = h.part;
-        const glm::vec3 hitP = h.p, ng = h.ng, ns = h.ns;
-        // Rule 6: length inside non-air media.
-        if (before >= 0) res.length += glm::length(hitP - from);
-        from = hitP;
+void Tracer::traceCoherent(glm::vec3 p, glm::vec3 n, const glm::vec3* omegas, size_t count,
+                           uint32_t part, PathResult* out) const {
+    // Scratch per thread: the paths in flight and one Embree ray per active path.
+    thread_local std::vector<Path> paths;
+    thread_local std::vector<uint32_t> active;
+    thread_local std::vector<RTCRayHit> rays;
+    paths.resize(count);
+    active.clear();
+    for (size_t j = 0; j < count; ++j)
+        if (start(p, n, omegas[j], part, &paths[j])) active.push_back(uint32_t(j));
+        else out[j] = paths[j].res;
 
-        const bool entering = glm::dot(d, ng) < 0.0f;
-        if (entering && media.n == 0) res.flags |= kPathReentered;  // it had left: rule 4
-        MediaStack next = media;
-        if (entering) next.add(q); else next.remove(q);
-        const int after = next.top(s);
-
-        if (after == before) {
-            // A boundary inside a medium of higher priority: not an interface, go straight on.
-            media = next;
-            org = hitP + d * eps;
-            continue;
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    // Step by step: segment k of every path still active, in one stream. The first step's rays
+    // share their origin; neighbouring grid directions stay close for several bounces.
+    while (!active.empty()) {
+        rays.resize(active.size());
+        for (size_t a = 0; a < active.size(); ++a) {
+            const Path& path = paths[active[a]];
+            rays[a] = ray(path.org, path.d);
         }
-        // Normals facing the side the ray comes from.
-        const glm::vec3 ngf = entering ? ng : -ng;
-        glm::vec3 nf = entering ? ns : -ns;
-        const glm::vec3 wi = -d;
-        // Rule 3: a shading normal that faces away from the incoming ray cannot be used.
-        if (glm::dot(nf, wi) <= 0.0f) {
-            nf = ngf;
-            res.flags |= kPathGeometricNormal;
+        rtcIntersect1M(rtc_->scene, &ctx, rays.data(), unsigned(rays.size()), sizeof(RTCRayHit));
+        size_t kept = 0;
+        for (size_t a = 0; a < active.size(); ++a) {
+            const uint32_t j = active[a];
+            if (advance(&paths[j], rays[a])) active[kept++] = j;
+            else out[j] = paths[j].res;
         }
-        const float eta = iorOf(s, after) / iorOf(s, before);
-        glm::vec3 wt;
-        bool canTransmit = Refract(wi, nf, eta, &wt);
-        if (canTransmit && glm::dot(wt, ngf) >= 0.0f) {
-            // Rule 3: refracted onto the wrong side of the true surface: redo about Ng.
-            res.flags |= kPathGeometricNormal;
-            nf = ngf;
-            canTransmit = Refract(wi, nf, eta, &wt);
-        }
-        bool reflect;
-        if (!canTransmit) {
-            reflect = true;  // Rule 2: total internal reflection
-            res.flags |= kPathTIR;
-        } else if (options_.branch == Branch::Transmit) {
-            reflect = false;
-        } else {
-            const bool larger = FresnelDielectric(glm::dot(wi, nf), eta) > 0.5f;
-            // Rule 5: past half the cap, take the transmitted branch whenever it exists, so
-            // every path ends deterministically.
-            reflect = larger && res.bounces < cap / 2;  // else the larger branch
-            if (larger && !reflect) res.flags |= kPathSoftCapped;
-        }
-        if (reflect) {
-            d = Reflect(wi, nf);
-            if (glm::dot(d, ngf) <= 0.0f) {
-                res.flags |= kPathGeometricNormal;
-                d = Reflect(wi, ngf);
-            }
-            org = hitP + ngf * eps;
-        } else {
-            d = wt;
-            media = next;
-            org = hitP - ngf * eps;
-        }
-        d = glm::normalize(d);
-        ++res.bounces;
-        if (res.bounces >= cap) {
-            // Rule 5: the hard cap. The path ends here, along its current direction.
-            res.flags |= kPathCapped;
-            res.exit = d;
-            return res;
-        }
+        active.resize(kept);
     }
 }
 

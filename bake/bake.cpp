@@ -291,20 +291,25 @@ SliceResult BakePlan::bakeSlice(size_t beginBatch, size_t endBatch, const SliceP
 }
 
 nlohmann::json BakePlan::manifest(const BakeStats& stats) const {
+    // Paths absolute, so that the same bake run from another folder (a scheduler's job, a
+    // merge) describes itself the same way.
+    auto absolute = [](const std::string& path) {
+        std::error_code ec;
+        auto abs = std::filesystem::absolute(path, ec);
+        return ec ? path : abs.lexically_normal().string();
+    };
     nlohmann::json media = nlohmann::json::array();
     for (const Part& p : scene_.parts) {
         media.push_back({{"name", p.medium.name},
-                         {"mesh", p.meshPath},
+                         {"mesh", absolute(p.meshPath)},
                          {"ior", p.medium.ior},
                          {"absorption", {p.medium.absorption.x, p.medium.absorption.y, p.medium.absorption.z}},
                          {"priority", p.medium.priority},
                          {"meshChecksum", p.mesh.checksum()},
                          {"triangles", p.mesh.triangles.size()}});
     }
-    std::error_code ec;
-    auto abs = std::filesystem::absolute(input_, ec);
     return {
-        {"input", ec ? input_ : abs.string()},
+        {"input", absolute(input_)},
         {"grid", {opt_.grid.nTheta, opt_.grid.nPhi}},
         {"filterWidth", opt_.filterWidth},
         {"fit", ToString(opt_.fit)},

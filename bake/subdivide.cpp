@@ -50,8 +50,12 @@ SubdivisionResult subdivideMeshFile(const std::string& input, const std::string&
     }
     if (!ok) throw inputError(input, "OpenMesh's subdivider failed");
 
-    const std::string tmp = output + ".tmp." + std::to_string(::getpid());
-    if (!OpenMesh::IO::write_mesh(om, tmp)) {
+    // OpenMesh picks the format by extension: the temporary keeps it.
+    const std::filesystem::path out(output);
+    const std::string tmp = (out.parent_path() / (out.stem().string() + ".tmp." + std::to_string(::getpid()) +
+                                                  out.extension().string())).string();
+    // 9 significant digits: every float position written exactly (text formats).
+    if (!OpenMesh::IO::write_mesh(om, tmp, OpenMesh::IO::Options::Default, 9)) {
         std::remove(tmp.c_str());
         throw inputError(output, "cannot write (unknown extension or unwritable folder)");
     }

@@ -2,6 +2,8 @@
 // `shrefract-merge`, against the single-machine bake of the same mesh (docs/bake.md "Shards").
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -32,21 +34,32 @@ void expectSameBake(const std::string& a, const std::string& b) {
     EXPECT_EQ(test::bakeDifference(readBake(a), readBake(b)), "") << a << " and " << b;
 }
 
-// Bakes the single-machine reference once per precision.
+// Bakes the single-machine reference once per precision and process (never an older build's).
 std::string reference(const std::string& precision) {
-    const std::string out = tmp("shard_ref_" + precision + ".shrefract.exr");
-    if (!fs::exists(out)) {
+    struct RemovedAtExit {
+        std::set<std::string> paths;
+        ~RemovedAtExit() {
+            for (const std::string& p : paths) fs::remove(p);
+        }
+    };
+    static RemovedAtExit made;
+    const std::string out = tmp("shard_ref_" + precision + "_" + std::to_string(::getpid()) + ".shrefract.exr");
+    if (made.paths.insert(out).second) {
         CommandResult r = run(kBake + " " + kCow + " -o " + out + kArgs + " --precision " + precision);
         EXPECT_EQ(r.code, 0) << r.out;
     }
     return out;
 }
 
+// Shard i of n: the first from the mesh's own folder by a relative path, as a job on another
+// machine may find it; the others by the absolute path the reference uses.
 std::vector<std::string> bakeShards(const std::string& name, int n, const std::string& extra = "") {
     std::vector<std::string> shards;
     for (int i = 0; i < n; ++i) {
         const std::string s = tmp(name + "_" + std::to_string(i) + "_of_" + std::to_string(n) + ".exr");
-        CommandResult r = run(kBake + " " + kCow + " -o " + s + kArgs + " --shard " +
+        const std::string input = i == 0 ? "cd " + fs::path(kCow).parent_path().string() + " && " + kBake + " cow.off"
+                                         : kBake + " " + kCow;
+        CommandResult r = run(input + " -o " + s + kArgs + " --shard " +
                               std::to_string(i) + "/" + std::to_string(n) + extra);
         EXPECT_EQ(r.code, 0) << r.out;
         shards.push_back(s);

@@ -136,6 +136,7 @@ struct BakePlan::Compression {
     std::vector<double> h;                   // band filter, per band
     std::vector<int> band;                   // band of each stored coefficient
     std::vector<glm::vec3> dirs;             // grid directions, local frame
+    std::vector<uint32_t> order;             // the order they are traced in: packetOrder(grid)
 };
 
 BakePlan::BakePlan(const Scene& scene, const BakeOptions& opt, const std::string& inputPath)
@@ -166,6 +167,7 @@ void BakePlan::prepareTracing() const {
         }
         c->dirs.resize(J);
         for (int j = 0; j < J; ++j) c->dirs[j] = glm::vec3(opt_.grid.direction(j));
+        c->order = packetOrder(opt_.grid.nTheta, opt_.grid.nPhi);
         compression_ = std::move(c);
         tracer_ = std::make_unique<Tracer>(scene_, opt_.trace);
     });
@@ -184,6 +186,7 @@ SliceResult BakePlan::bakeSlice(size_t beginBatch, size_t endBatch, const SliceP
     const Compression& compression = *compression_;
     const Eigen::MatrixXf& Mt = compression.Mt;
     const std::vector<glm::vec3>& dirs = compression.dirs;
+    const std::vector<uint32_t>& order = compression.order;
     const bool weighted = compression.fitter != nullptr;
     const size_t n = L.position.size();
     const int K = shEvenCount(opt.order);
@@ -221,16 +224,18 @@ SliceResult BakePlan::bakeSlice(size_t beginBatch, size_t endBatch, const SliceP
             for (size_t s = 0; s < batchCount; ++s) {
                 const size_t i = batchFirst + s;
                 const Frame frame = Frame::fromNormal(L.normal[i]);
-                for (int j = 0; j < J; ++j) omegas[j] = frame.fromLocal(dirs[j]);
+                // Directions in packet order: paths[q] is direction order[q]'s.
+                for (int q = 0; q < J; ++q) omegas[q] = frame.fromLocal(dirs[order[q]]);
                 if (opt.coherent) {
                     tracer.traceCoherent(L.position[i], L.normal[i], omegas.data(), J, L.part[i], paths.data());
                 } else {
-                    for (int j = 0; j < J; ++j) paths[j] = tracer.trace(L.position[i], L.normal[i], omegas[j], L.part[i]);
+                    for (int q = 0; q < J; ++q) paths[q] = tracer.trace(L.position[i], L.normal[i], omegas[q], L.part[i]);
                 }
                 if (opt.footprintSamples > 1)
                     localRays += averageOverFootprint(tracer, L, i, opt.footprintSamples, opt.coherent, omegas, paths);
-                for (int j = 0; j < J; ++j) {
-                    const PathResult& p = paths[j];
+                for (int q = 0; q < J; ++q) {
+                    const PathResult& p = paths[q];
+                    const int j = int(order[q]);
                     if (weighted) batchPaths[s * J + j] = p;
                     R(j, 4 * s + 0) = p.exit.x;
                     R(j, 4 * s + 1) = p.exit.y;

@@ -70,8 +70,9 @@ public:
                      std::vector<LoggedRay>* log = nullptr) const;
     // The paths of one sample for `count` directions omegas[j] (object space), by the same rules
     // as trace(), traced path step by path step: segment k of every path still active goes to
-    // Embree as one stream of coherent rays (rtcIntersect1M, RTC_INTERSECT_CONTEXT_FLAG_COHERENT).
-    // out[j] is omegas[j]'s path. The same exits as trace() to float tolerance.
+    // Embree as one stream, the first (shared origin) as coherent packets of 16 consecutive
+    // directions (give them in packetOrder), the later ones ray by ray, their triangles fetched
+    // ahead. out[j] is omegas[j]'s path. The same exits as trace() to float tolerance.
     void traceCoherent(glm::vec3 p, glm::vec3 n, const glm::vec3* omegas, size_t count,
                        uint32_t part, PathResult* out) const;
 
@@ -95,6 +96,10 @@ private:
     std::unique_ptr<Embree> rtc_;
     float epsilon_ = 1e-5f;
 };
+
+// The grid directions (index i * nPhi + k) in 4 x 4 tiles of (theta, phi): the order in which
+// traceCoherent's 16-ray packets are compact cones.
+std::vector<uint32_t> packetOrder(int nTheta, int nPhi);
 
 // Sets flush-to-zero and denormals-are-zero on the calling thread (every tracing thread).
 void enableFlushToZero();

@@ -216,12 +216,12 @@ TEST(Tracer, RayOffsetsScaleWithTheScene) {
 // complexity 6 (bead in shell), re-entry (knot). Samples on every 29th vertex (the bunny: every
 // 151st), the paper's 32 x 64 grid.
 //
-// Embree's packet traversal and its single-ray one may disagree in the last float bit, and on
-// which side of a crack between two triangles a ray passes. Measured on every 37th bunny vertex:
-// 2 of 2,088,960 paths differ, one bouncing 17 times (chaos amplifies the last bit), one that
-// one traversal sees leak through a crack; knot1, diamond and bead_in_shell: none. Allowed: 1 in
-// 100,000 paths (10x the measured rate); a planted bug in the shared event code or in the
-// stream bookkeeping moves thousands.
+// Embree's packet traversal (the first step) and its single-ray one may disagree in the last
+// float bit, and on which side of a crack between two triangles a ray passes; a long chaotic
+// path amplifies either. Measured: none of 2,088,960 paths at every 37th bunny vertex (with all
+// steps as coherent streams, an earlier variant: 2, one bouncing 17 times, one leaking through a
+// crack); knot1, diamond, bead_in_shell: none. Allowed: 1 in 100,000 paths; a planted bug in the
+// shared event code or in the stream bookkeeping moves thousands.
 class CoherentTracer : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(CoherentTracer, GivesTheScalarTracersExitsToFloatTolerance) {
@@ -231,6 +231,7 @@ TEST_P(CoherentTracer, GivesTheScalarTracersExitsToFloatTolerance) {
     enableFlushToZero();
     const DirectionGrid grid;
     const size_t stride = name.find("bunny") != std::string::npos ? 151 : 29;
+    const std::vector<uint32_t> order = packetOrder(grid.nTheta, grid.nPhi);  // as the bake does
     std::vector<glm::vec3> omegas(grid.count());
     std::vector<PathResult> coherent(grid.count());
     size_t paths = 0, differ = 0;
@@ -238,7 +239,7 @@ TEST_P(CoherentTracer, GivesTheScalarTracersExitsToFloatTolerance) {
         const Mesh& m = s.parts[part].mesh;
         for (size_t v = 0; v < m.positions.size(); v += stride) {
             const Frame f = Frame::fromNormal(m.normals[v]);
-            for (int j = 0; j < grid.count(); ++j) omegas[j] = f.fromLocal(glm::vec3(grid.direction(j)));
+            for (int j = 0; j < grid.count(); ++j) omegas[j] = f.fromLocal(glm::vec3(grid.direction(order[j])));
             tracer.traceCoherent(m.positions[v], m.normals[v], omegas.data(), omegas.size(), part,
                                  coherent.data());
             for (int j = 0; j < grid.count(); ++j) {

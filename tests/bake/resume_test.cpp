@@ -120,6 +120,8 @@ TEST(Resume, AfterSigkillAtRandomMomentsResumeGivesTheSameFile) {
             }
         }
         resumedFromCheckpoints += complete > 0;
+        std::printf("[ note ] kill %d at %.2f s: %d complete checkpoints, output %s\n", rep, delay, complete,
+                    fs::exists(out) ? "written" : "absent");
         CommandResult r = run(bakeCommand(out, " --resume"));
         ASSERT_EQ(r.code, 0) << "resume after a kill at " << delay << " s: " << r.out;
         const std::string why = differenceFromReference(out);

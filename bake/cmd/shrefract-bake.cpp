@@ -175,6 +175,10 @@ int main(int argc, char** argv) {
             if (!quiet) std::fprintf(stderr, "%s%s\n", tty ? "\r" : "", text.c_str());
         };
         BakePlan plan(scene, opt, input);
+        if (resume) {
+            const int stale = removeStaleTemporaries(output);
+            if (stale > 0) note("resume: removed " + std::to_string(stale) + " temporary file(s) a killed bake left");
+        }
         if (!shardText.empty()) {
             // One slice into a shard file, for shrefract-merge.
             if (resume && fs::exists(output)) {
@@ -210,10 +214,6 @@ int main(int argc, char** argv) {
             res.stats = all.stats;
             res.data = plan.data(std::move(all.weights), res.stats);
         } else {
-            if (resume) {
-                const int stale = removeStaleTemporaries(output);
-                if (stale > 0) note("resume: removed " + std::to_string(stale) + " temporary file(s) a killed bake left");
-            }
             CheckpointOptions co;
             co.workDir = workDir;
             co.count = nCheckpoints;

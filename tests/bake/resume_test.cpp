@@ -28,7 +28,8 @@ const std::string kBake = SHREFRACT_BAKE_EXE;
 // cow at rate 1 on an 8 x 16 grid: 2904 samples, 372 k paths, under a second on 2 cores, cut
 // into 12 checkpoints.
 const std::string kInput = std::string(SHREFRACT_DATA_DIR) + "/meshes/cow.off";
-const std::string kArgs = " --rate 1 --grid 8x16 --order 4 --cache '' -q";
+// (--cache "": these commands also run inside sh -c '...', where '' would end the quoting.)
+const std::string kArgs = " --rate 1 --grid 8x16 --order 4 --cache \"\" -q";
 
 std::string bakeCommand(const std::string& out, const std::string& extra = "") {
     return kBake + " " + kInput + " -o " + out + kArgs + " --checkpoints 12" + extra;

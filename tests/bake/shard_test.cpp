@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -34,8 +35,9 @@ void expectSameBake(const std::string& a, const std::string& b) {
     EXPECT_EQ(test::bakeDifference(readBake(a), readBake(b)), "") << a << " and " << b;
 }
 
-// Bakes the single-machine reference once per precision and process (never an older build's).
-std::string reference(const std::string& precision) {
+// Bakes the single-machine reference once per option set and process (never an older build's).
+// `options`: extra bake options, e.g. " --precision u8".
+std::string reference(const std::string& options) {
     struct RemovedAtExit {
         std::set<std::string> paths;
         ~RemovedAtExit() {
@@ -43,9 +45,12 @@ std::string reference(const std::string& precision) {
         }
     };
     static RemovedAtExit made;
-    const std::string out = tmp("shard_ref_" + precision + "_" + std::to_string(::getpid()) + ".shrefract.exr");
+    std::string name = options;
+    for (char& c : name)
+        if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+    const std::string out = tmp("shard_ref" + name + "_" + std::to_string(::getpid()) + ".shrefract.exr");
     if (made.paths.insert(out).second) {
-        CommandResult r = run(kBake + " " + kCow + " -o " + out + kArgs + " --precision " + precision);
+        CommandResult r = run(kBake + " " + kCow + " -o " + out + kArgs + options);
         EXPECT_EQ(r.code, 0) << r.out;
     }
     return out;
@@ -91,29 +96,38 @@ TEST(Shard, SlicesStartAtBatchBoundariesAndCoverEveryBatchOnce) {
     }
 }
 
-class MergedShards : public ::testing::TestWithParam<std::pair<int, const char*>> {};
+struct MergeCase {
+    const char* name;
+    int n;
+    const char* options;  // extra bake options, for the shards and the reference alike
+};
+
+class MergedShards : public ::testing::TestWithParam<MergeCase> {};
 
 // The merge writes what one machine writes: the same weights bit for bit, the same manifest
 // but for the time it took.
 TEST_P(MergedShards, EqualTheSingleMachineBake) {
-    const auto [n, precision] = GetParam();
-    const std::string name = "merged_" + std::to_string(n) + "_" + precision;
-    const std::vector<std::string> shards = bakeShards(name, n, std::string(" --precision ") + precision);
+    const MergeCase& c = GetParam();
+    const std::string name = std::string("merged_") + c.name;
+    const std::vector<std::string> shards = bakeShards(name, c.n, c.options);
     const std::string out = tmp(name + ".shrefract.exr");
     fs::remove(out);
     // In reverse order: the merge orders them by their slice, not by the command line.
     std::vector<std::string> reversed(shards.rbegin(), shards.rend());
     CommandResult r = run(kMerge + " " + out + joined(reversed));
     ASSERT_EQ(r.code, 0) << r.out;
-    expectSameBake(out, reference(precision));
+    expectSameBake(out, reference(c.options));
 }
 
+// N = 1, 4, 7 (91 batches: uneven slices); 8-bit weights, quantized over the whole bake by the
+// merge; the weighted fit, which solves per sample; the scalar tracer.
 INSTANTIATE_TEST_SUITE_P(Counts, MergedShards,
-                         ::testing::Values(std::make_pair(1, "f32"), std::make_pair(4, "f32"),
-                                           std::make_pair(7, "f32"), std::make_pair(4, "u8")),
-                         [](const auto& info) {
-                             return std::to_string(info.param.first) + "_" + info.param.second;
-                         });
+                         ::testing::Values(MergeCase{"1", 1, ""}, MergeCase{"4", 4, ""},
+                                           MergeCase{"7", 7, ""},
+                                           MergeCase{"4_u8", 4, " --precision u8"},
+                                           MergeCase{"3_weighted", 3, " --fit weighted"},
+                                           MergeCase{"2_scalar", 2, " --tracer scalar"}),
+                         [](const auto& info) { return std::string(info.param.name); });
 
 // With --shard N alone, the index comes from SLURM_ARRAY_TASK_ID: the same shard as --shard I/N.
 TEST(Shard, SlurmArrayTaskIdGivesTheIndex) {
@@ -215,7 +229,7 @@ TEST_F(MergeRejects, ATruncatedShard) {
 }
 
 TEST_F(MergeRejects, ABakeInsteadOfAShard) {
-    expectRefused(four_[0] + " " + reference("f32"), "is a bake, not a shard");
+    expectRefused(four_[0] + " " + reference(""), "is a bake, not a shard");
 }
 
 TEST_F(MergeRejects, AnotherMesh) {

@@ -332,12 +332,13 @@ std::pair<int, int> neighbourListSize(size_t E) {
 // Writing.
 
 Imf::Header partHeader(const char* name, int width, int height, const Imath::Box2i& display,
-                       const std::string& manifest) {
+                       const std::string& manifest,
+                       Imf::Compression compression = Imf::ZIP_COMPRESSION) {
     Imf::Header h(width, height);
     h.displayWindow() = display;  // shared by all parts of a multi-part file
     h.setName(name);
     h.setType(Imf::SCANLINEIMAGE);
-    h.compression() = Imf::ZIP_COMPRESSION;
+    h.compression() = compression;
     h.insert(kManifestAttribute, Imf::StringAttribute(manifest));
     h.insert(kManifestChecksumAttribute, Imf::StringAttribute(checksumHex(manifest)));
     return h;
@@ -353,17 +354,31 @@ void writeWhole(Imf::MultiPartOutputFile& file, int part, Planes& planes, int he
     out.writePixels(height);
 }
 
-// Rows y0 .. y0 + rows - 1 of the weights part, quantized to the bake's precision.
-Planes weightChunk(const BakeData& d, const U8Params& u8, int y0, int rows) {
-    const SurfaceLayout& L = d.layout;
-    const int K = d.coefficientCount();
-    const size_t N = L.position.size();
-    Planes chunk(L.muWidth, rows, weightChannels(K, d.precision));
-    for (size_t t = 0; t < size_t(L.muWidth) * rows; ++t) {
-        const size_t i = size_t(y0) * L.muWidth + t;
+// The weights of N samples as a part stores them: texel i at (i % width, i / width), K
+// coefficients of 4 channels each; in memory weights[(k * N + i) * 4 + c] (BakeData::weights).
+struct WeightsPart {
+    const float* data;
+    size_t N;
+    int K;
+    Precision precision;
+    int width, height;
+};
+
+WeightsPart weightsPart(const BakeData& d) {
+    return {d.weights.data(), d.layout.position.size(), d.coefficientCount(), d.precision,
+            d.layout.muWidth, d.layout.muHeight};
+}
+
+// Rows y0 .. y0 + rows - 1 of the weights part, quantized to its precision.
+Planes weightChunk(const WeightsPart& d, const U8Params& u8, int y0, int rows) {
+    const int K = d.K;
+    const size_t N = d.N;
+    Planes chunk(d.width, rows, weightChannels(K, d.precision));
+    for (size_t t = 0; t < size_t(d.width) * rows; ++t) {
+        const size_t i = size_t(y0) * d.width + t;
         if (i >= N) break;  // texels past the last sample stay zero
         for (int k = 0; k < K; ++k) {
-            const float* w = &d.weights[(size_t(k) * N + i) * 4];
+            const float* w = &d.data[(size_t(k) * N + i) * 4];
             if (d.precision == Precision::U8) {
                 uint32_t packed = 0;
                 for (int c = 0; c < 4; ++c)
@@ -387,31 +402,63 @@ Planes weightChunk(const BakeData& d, const U8Params& u8, int y0, int rows) {
 }
 
 // The checksum of the whole weights part, chunk by chunk as it will be written.
-std::string weightsChecksum(const BakeData& d, const U8Params& u8) {
+std::string weightsChecksum(const WeightsPart& d, const U8Params& u8) {
     Checksum sum;
-    for (int y0 = 0; y0 < d.layout.muHeight; y0 += kChunkRows) {
-        const Planes chunk = weightChunk(d, u8, y0, std::min(kChunkRows, d.layout.muHeight - y0));
+    for (int y0 = 0; y0 < d.height; y0 += kChunkRows) {
+        const Planes chunk = weightChunk(d, u8, y0, std::min(kChunkRows, d.height - y0));
         sum.update(chunk.bytes().data(), chunk.bytes().size());
     }
     return sum.hex();
 }
 
-void writeWeights(Imf::MultiPartOutputFile& file, int part, const BakeData& d, const U8Params& u8) {
+void writeWeights(Imf::MultiPartOutputFile& file, int part, const WeightsPart& d, const U8Params& u8) {
     Imf::OutputPart out(file, part);
-    for (int y0 = 0; y0 < d.layout.muHeight; y0 += kChunkRows) {
-        const int rows = std::min(kChunkRows, d.layout.muHeight - y0);
+    for (int y0 = 0; y0 < d.height; y0 += kChunkRows) {
+        const int rows = std::min(kChunkRows, d.height - y0);
         Planes chunk = weightChunk(d, u8, y0, rows);
         out.setFrameBuffer(chunk.frameBuffer(y0));
         out.writePixels(rows);
     }
 }
 
-// Flushes the file's data to disk before the rename makes it visible under its final name.
-void syncFile(const std::string& path) {
+// Flushes a file's data (or a folder's entries) to disk.
+void syncPath(const std::string& path) {
     const int fd = ::open(path.c_str(), O_RDONLY);
     if (fd < 0) return;
     ::fsync(fd);
     ::close(fd);
+}
+
+// Writes `path` all or nothing: `write(stream, tmpName)` fills PATH.tmp.PID in the same folder,
+// which is flushed to disk, renamed onto `path`, and the folder's entry flushed too (a power cut
+// then leaves the old file or the new one, never a part). Any failure removes the temporary and
+// leaves an existing file at `path` as it was; I/O failures are InputErrors naming `path`.
+template <class Write>
+void writeAtomically(const std::string& path, Write&& write) {
+    const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+    try {
+        std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
+        if (!os) throw inputError(path, str("cannot create ", tmp, ": ", std::strerror(errno)));
+        {
+            Imf::StdOFStream stream(os, tmp.c_str());
+            write(stream);
+        }  // the file's destructor writes the chunk offset tables; it swallows errors, the stream not
+        os.flush();
+        os.close();
+        if (os.fail())
+            throw inputError(path, str("cannot write ", tmp, ": ", std::strerror(errno)));
+        syncPath(tmp);
+        if (std::rename(tmp.c_str(), path.c_str()) != 0)
+            throw inputError(path, str("cannot rename ", tmp, " to it: ", std::strerror(errno)));
+        const std::filesystem::path folder = std::filesystem::absolute(path).parent_path();
+        syncPath(folder.string());
+    } catch (const Iex::BaseExc& e) {
+        std::remove(tmp.c_str());
+        throw inputError(path, str("cannot write: ", e.what()));
+    } catch (...) {
+        std::remove(tmp.c_str());
+        throw;
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -503,6 +550,43 @@ void readWhole(Imf::MultiPartInputFile& file, int part, Planes& planes, int heig
     if (verifier.on()) verifier.check(name, checksumHex(planes.bytes().data(), planes.bytes().size()));
 }
 
+// The weights part into out[(k * N + i) * 4 + c], a band of rows at a time, dequantized to float.
+// Verified, every row is read (the checksum covers the padding past the last sample too).
+void readWeights(Imf::MultiPartInputFile& file, int part, const WeightsPart& shape, float* out,
+                 const U8Params& u8, const Verifier& verifier) {
+    const int K = shape.K;
+    const size_t N = shape.N;
+    const std::vector<Channel> channels = weightChannels(K, shape.precision);
+    Imf::InputPart in(file, part);
+    Checksum sum;
+    for (int y0 = 0; y0 < shape.height && (verifier.on() || size_t(y0) * shape.width < N);
+         y0 += kChunkRows) {
+        const int rows = std::min(kChunkRows, shape.height - y0);
+        Planes chunk(shape.width, rows, channels);
+        in.setFrameBuffer(chunk.frameBuffer(y0));
+        in.readPixels(y0, y0 + rows - 1);
+        sum.update(chunk.bytes().data(), chunk.bytes().size());
+        for (size_t t = 0; t < size_t(shape.width) * rows; ++t) {
+            const size_t i = size_t(y0) * shape.width + t;
+            if (i >= N) break;
+            for (int k = 0; k < K; ++k) {
+                float* w = &out[(size_t(k) * N + i) * 4];
+                if (shape.precision == Precision::U8) {
+                    const uint32_t packed = chunk.u(t, k);
+                    for (int c = 0; c < 4; ++c)
+                        w[c] = dequantU8(u8.scale[k * 4 + c], u8.offset[k * 4 + c],
+                                         (packed >> (8 * c)) & 0xffu);
+                } else {
+                    for (int c = 0; c < 4; ++c)
+                        w[c] = shape.precision == Precision::F16 ? chunk.h(t, k * 4 + c)
+                                                                 : chunk.f(t, k * 4 + c);
+                }
+            }
+        }
+    }
+    verifier.check(kWeightsPart, sum.hex());
+}
+
 // The manifest text of part 0, checked against its checksum and the copies in the other parts.
 std::string manifestText(Imf::MultiPartInputFile& file, int version, bool verify) {
     const auto* text = file.header(0).findTypedAttribute<Imf::StringAttribute>(kManifestAttribute);
@@ -520,9 +604,9 @@ std::string manifestText(Imf::MultiPartInputFile& file, int version, bool verify
     return text->value();
 }
 
-BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
-    // The manifest of the first part is the one that counts. Its version decides how it is
-    // verified, so it is parsed once unverified, then taken again through its checksum.
+// The manifest of the first part, the one that counts. Its version decides how it is verified,
+// so it is parsed once unverified, then taken again through its checksum.
+json openManifest(Imf::MultiPartInputFile& file, bool verify, int* version) {
     const auto* raw = file.header(0).findTypedAttribute<Imf::StringAttribute>(kManifestAttribute);
     if (!raw) throw InputError("not a shrefract bake (no \"shrefract.manifest\" attribute)");
     json m = json::parse(raw->value(), nullptr, /*allow_exceptions=*/false);
@@ -530,12 +614,26 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
         throw InputError("not a shrefract bake (the manifest is not a JSON object)");
     if (!m.contains("format") || m["format"] != "shrefract")
         throw InputError("not a shrefract bake (manifest \"format\" is not \"shrefract\")");
-    const int version = manifestInt(m, "version");
-    if (version > kFormatVersion)
-        throw InputError(str("format version ", version, " is newer than this build reads (",
+    *version = manifestInt(m, "version");
+    if (*version > kFormatVersion)
+        throw InputError(str("format version ", *version, " is newer than this build reads (",
                              kFormatVersion, ")"));
-    if (version < 1) throw InputError(str("format version ", version, " is invalid"));
-    manifestText(file, version, options.verify);
+    if (*version < 1) throw InputError(str("format version ", *version, " is invalid"));
+    manifestText(file, *version, verify);
+    return m;
+}
+
+// "slice 2 of 4" from a shard manifest's "shard" object, for messages.
+std::string sliceName(const json& shard) {
+    return str("slice ", shard.value("index", -1), " of ", shard.value("count", -1));
+}
+
+BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
+    int version = 0;
+    json m = openManifest(file, options.verify, &version);
+    if (m.contains("shard"))
+        throw InputError(str("is a shard (", sliceName(m["shard"]),
+                             " of a bake), not a bake: merge a bake's shards with shrefract-merge"));
     std::vector<std::string> warnings;
     if (version < 2)
         warnings.push_back(str("format version ", version,
@@ -611,39 +709,9 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
         throw InputError(str("neighbour list of ", nlLength, " entries does not fit its ", nlWidth,
                              " x ", nlHeight, " part"));
 
-    // Weights, a band of rows at a time, dequantized to float. Verified, every row is read (the
-    // checksum covers the padding past the last sample too).
     d.weights.assign(size_t(K) * N * 4, 0.0f);
-    {
-        Imf::InputPart in(file, pWeights);
-        Checksum sum;
-        for (int y0 = 0; y0 < L.muHeight && (verifier.on() || int64_t(y0) * L.muWidth < N);
-             y0 += kChunkRows) {
-            const int rows = std::min(kChunkRows, L.muHeight - y0);
-            Planes chunk(L.muWidth, rows, wChannels);
-            in.setFrameBuffer(chunk.frameBuffer(y0));
-            in.readPixels(y0, y0 + rows - 1);
-            sum.update(chunk.bytes().data(), chunk.bytes().size());
-            for (size_t t = 0; t < size_t(L.muWidth) * rows; ++t) {
-                const size_t i = size_t(y0) * L.muWidth + t;
-                if (i >= size_t(N)) break;
-                for (int k = 0; k < K; ++k) {
-                    float* w = &d.weights[(size_t(k) * N + i) * 4];
-                    if (d.precision == Precision::U8) {
-                        const uint32_t packed = chunk.u(t, k);
-                        for (int c = 0; c < 4; ++c)
-                            w[c] = dequantU8(u8.scale[k * 4 + c], u8.offset[k * 4 + c],
-                                             (packed >> (8 * c)) & 0xffu);
-                    } else {
-                        for (int c = 0; c < 4; ++c)
-                            w[c] = d.precision == Precision::F16 ? chunk.h(t, k * 4 + c)
-                                                                 : chunk.f(t, k * 4 + c);
-                    }
-                }
-            }
-        }
-        verifier.check(kWeightsPart, sum.hex());
-    }
+    readWeights(file, pWeights, {nullptr, size_t(N), K, d.precision, L.muWidth, L.muHeight},
+                d.weights.data(), u8, verifier);
 
     Planes samples(L.muWidth, L.muHeight, kSampleChannels);
     readWhole(file, pSamples, samples, L.muHeight, verifier, kSamplesPart);
@@ -682,6 +750,66 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
     d.manifest = std::move(m);
     d.warnings = std::move(warnings);
     return d;
+}
+
+ShardData readShardParts(Imf::MultiPartInputFile& file, bool weights) {
+    int version = 0;
+    json m = openManifest(file, true, &version);
+    if (!m.contains("shard") || !m["shard"].is_object())
+        throw InputError("is a bake, not a shard (its manifest has no \"shard\")");
+    if (version < 2) throw InputError(str("shard of format version ", version, " (shards are 2+)"));
+    const Verifier verifier(m, true);
+    ShardData d;
+    d.order = manifestInt(m, "order");
+    if (d.order < 0 || d.order > 100) throw InputError(str("SH order ", d.order, " is absurd"));
+    const int K = shEvenCount(d.order);
+    if (manifestInt(m, "coefficients") != K)
+        throw InputError(str("manifest says ", manifestInt(m, "coefficients"),
+                             " coefficients, order ", d.order, " has ", K));
+    if (m.value("precision", "") != "f32") throw InputError("shard weights are not f32");
+    const int N = manifestInt(m, "sampleCount");
+    const std::vector<int> size = manifestInts(m, "weightsSize", 2);
+    if (N < 0 || size[0] < 1 || size[1] < 1 || int64_t(N) > int64_t(size[0]) * size[1])
+        throw InputError(str(N, " samples do not fit the ", size[0], " x ", size[1], " weights part"));
+    d.sampleCount = size_t(N);
+    if (weights) {
+        int part = -1;
+        for (int p = 0; p < file.parts(); ++p)
+            if (file.header(p).hasName() && file.header(p).name() == kWeightsPart) part = p;
+        if (part < 0) throw InputError(str("missing part \"", kWeightsPart, "\""));
+        checkPart(file.header(part), kWeightsPart, size[0], size[1], weightChannels(K, Precision::F32));
+        d.weights.assign(size_t(K) * d.sampleCount * 4, 0.0f);
+        readWeights(file, part, {nullptr, d.sampleCount, K, Precision::F32, size[0], size[1]},
+                    d.weights.data(), U8Params{}, verifier);
+    }
+    d.manifest = std::move(m);
+    return d;
+}
+
+// Opens `path` for one of the readers, turning every failure into an InputError naming it.
+template <class Read>
+auto readFile(const std::string& path, Read&& read) {
+    std::error_code ec;
+    const auto status = std::filesystem::status(path, ec);
+    if (!std::filesystem::exists(status)) throw inputError(path, "file not found");
+    if (std::filesystem::is_directory(status))
+        throw inputError(path, "is a directory, not a bake file");
+
+    std::unique_ptr<Imf::MultiPartInputFile> file;
+    try {
+        file = std::make_unique<Imf::MultiPartInputFile>(path.c_str());
+    } catch (const std::exception& e) {
+        throw inputError(path, str("not an OpenEXR file: ", e.what()));
+    }
+    try {
+        return read(*file);
+    } catch (const InputError& e) {
+        throw inputError(path, e.what());
+    } catch (const Iex::BaseExc& e) {
+        throw inputError(path, str("truncated or corrupt: ", e.what()));
+    } catch (const std::bad_alloc&) {
+        throw inputError(path, "sizes too large to load");
+    }
 }
 
 }  // namespace
@@ -744,7 +872,7 @@ void writeBake(const std::string& path, const BakeData& data) {
         m.erase("u8");
     m["checksums"] = {{"algorithm", kChecksumAlgorithm},
                       {"parts",
-                       {{kWeightsPart, weightsChecksum(data, u8)},
+                       {{kWeightsPart, weightsChecksum(weightsPart(data), u8)},
                         {kSamplesPart, sum(samples)},
                         {kRhoPart, sum(rho)},
                         {kNeighboursPart, sum(neighbours)},
@@ -769,57 +897,60 @@ void writeBake(const std::string& path, const BakeData& data) {
     addChannels(headers[3], kNeighbourChannels);
     addChannels(headers[4], kNeighbourListChannels);
 
-    const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-    try {
-        std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
-        if (!os) throw inputError(path, str("cannot create ", tmp, ": ", std::strerror(errno)));
-        {
-            Imf::StdOFStream stream(os, tmp.c_str());
-            Imf::MultiPartOutputFile file(stream, headers.data(), int(headers.size()));
-            writeWeights(file, 0, data, u8);
-            writeWhole(file, 1, samples, L.muHeight);
-            writeWhole(file, 2, rho, L.rhoHeight);
-            writeWhole(file, 3, neighbours, L.muHeight);
-            writeWhole(file, 4, list, nlHeight);
-        }  // the destructor writes the chunk offset tables; it swallows errors, the stream not
-        os.flush();
-        os.close();
-        if (os.fail())
-            throw inputError(path, str("cannot write ", tmp, ": ", std::strerror(errno)));
-        syncFile(tmp);
-        if (std::rename(tmp.c_str(), path.c_str()) != 0)
-            throw inputError(path, str("cannot rename ", tmp, " to it: ", std::strerror(errno)));
-    } catch (const Iex::BaseExc& e) {
-        std::remove(tmp.c_str());
-        throw inputError(path, str("cannot write: ", e.what()));
-    } catch (...) {
-        std::remove(tmp.c_str());
-        throw;
-    }
+    writeAtomically(path, [&](Imf::OStream& stream) {
+        Imf::MultiPartOutputFile file(stream, headers.data(), int(headers.size()));
+        writeWeights(file, 0, weightsPart(data), u8);
+        writeWhole(file, 1, samples, L.muHeight);
+        writeWhole(file, 2, rho, L.rhoHeight);
+        writeWhole(file, 3, neighbours, L.muHeight);
+        writeWhole(file, 4, list, nlHeight);
+    });
 }
 
 BakeData readBake(const std::string& path, const ReadOptions& options) {
-    std::error_code ec;
-    const auto status = std::filesystem::status(path, ec);
-    if (!std::filesystem::exists(status)) throw inputError(path, "file not found");
-    if (std::filesystem::is_directory(status))
-        throw inputError(path, "is a directory, not a bake file");
+    return readFile(path, [&](Imf::MultiPartInputFile& file) { return readParts(file, options); });
+}
 
-    std::unique_ptr<Imf::MultiPartInputFile> file;
+void writeShard(const std::string& path, const ShardData& shard) {
+    const int K = shEvenCount(shard.order);
+    if (shard.order < 0 || shard.weights.size() != size_t(K) * shard.sampleCount * 4)
+        throw std::invalid_argument(str("writeShard(", path, "): ", shard.weights.size(),
+                                        " weights, expected ", K, " coefficients x ",
+                                        shard.sampleCount, " samples x 4"));
+    if (!shard.manifest.is_object() || !shard.manifest.contains("shard") ||
+        !shard.manifest["shard"].is_object())
+        throw std::invalid_argument("writeShard(" + path + "): the manifest has no \"shard\" object");
+    const auto [width, height] = neighbourListSize(shard.sampleCount);
+    const WeightsPart part{shard.weights.data(), shard.sampleCount, K, Precision::F32, width, height};
+    json m = shard.manifest;
+    m["format"] = "shrefract";
+    m["version"] = kFormatVersion;
+    m["order"] = shard.order;
+    m["coefficients"] = K;
+    m["precision"] = "f32";
+    m["sampleCount"] = shard.sampleCount;
+    m["weightsSize"] = {width, height};
+    m["checksums"] = {{"algorithm", kChecksumAlgorithm},
+                      {"parts", {{kWeightsPart, weightsChecksum(part, U8Params{})}}}};
+    std::string text;
     try {
-        file = std::make_unique<Imf::MultiPartInputFile>(path.c_str());
-    } catch (const std::exception& e) {
-        throw inputError(path, str("not an OpenEXR file: ", e.what()));
+        text = m.dump();
+    } catch (const json::exception& e) {
+        throw std::invalid_argument("writeShard(" + path + "): manifest: " + e.what());
     }
-    try {
-        return readParts(*file, options);
-    } catch (const InputError& e) {
-        throw inputError(path, e.what());
-    } catch (const Iex::BaseExc& e) {
-        throw inputError(path, str("truncated or corrupt: ", e.what()));
-    } catch (const std::bad_alloc&) {
-        throw inputError(path, "sizes too large to load");
-    }
+    // Float weights hardly compress (docs/format.md "Size"): shards are stored uncompressed.
+    std::vector<Imf::Header> headers = {partHeader(kWeightsPart, width, height,
+                                                   Imath::Box2i({0, 0}, {width - 1, height - 1}),
+                                                   text, Imf::NO_COMPRESSION)};
+    addChannels(headers[0], weightChannels(K, Precision::F32));
+    writeAtomically(path, [&](Imf::OStream& stream) {
+        Imf::MultiPartOutputFile file(stream, headers.data(), int(headers.size()));
+        writeWeights(file, 0, part, U8Params{});
+    });
+}
+
+ShardData readShard(const std::string& path, bool weights) {
+    return readFile(path, [&](Imf::MultiPartInputFile& file) { return readShardParts(file, weights); });
 }
 
 }  // namespace shrefract

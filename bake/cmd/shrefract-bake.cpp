@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -10,15 +11,18 @@
 
 #include "bake/bake.h"
 #include "bake/layout.h"
+#include "bake/shard.h"
 #include "bake/target.h"
 #include "bake/cmd/common_cli.h"
 #include "common/error.h"
 
 using namespace shrefract;
+namespace fs = std::filesystem;
 
 namespace {
 std::atomic<bool> gCancel{false};
 void onSignal(int) { gCancel = true; }
+using Clock = std::chrono::steady_clock;
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -68,8 +72,26 @@ int main(int argc, char** argv) {
                    "directions is at most DEG degrees (overrides --order, --rate, --grid)")
         ->check(CLI::Range(0.001, 180.0));
     app.add_option("--target-report", targetReport, "write the --target-error search as JSON");
+    std::string shardText, workDir, tracer = "coherent";
+    int checkpoints = 0;
+    bool resume = false;
+    app.add_option("--shard", shardText,
+                   "bake slice I of N (I/N) into the -o shard file for shrefract-merge; N alone: "
+                   "the index from SLURM_ARRAY_TASK_ID");
+    app.add_option("--checkpoints", checkpoints,
+                   "slices a whole bake writes to its work folder as it goes (0: one per 2^24 "
+                   "paths; 1: none)")->capture_default_str()->check(CLI::Range(0, 1000000));
+    app.add_option("--work", workDir, "the checkpoints' folder (default: OUTPUT.work)");
+    app.add_flag("--resume", resume,
+                 "keep the complete checkpoints of an interrupted bake (or, with --shard, a "
+                 "complete shard file) and bake only the rest");
+    app.add_option("--tracer", tracer, "coherent: a sample's paths as Embree ray streams; scalar: "
+                                       "one ray at a time (the reference)")
+        ->capture_default_str()->check(CLI::IsMember({"coherent", "scalar"}));
     app.add_flag("-q,--quiet", quiet, "no progress output");
     CLI11_PARSE(app, argc, argv);
+    const auto start = Clock::now();
+    std::string checkpointDir;  // set once a checkpointed bake has begun
 
     try {
         opt.rate = rate;
@@ -80,7 +102,15 @@ int main(int argc, char** argv) {
         opt.fit = parseFit(fit);
         opt.weighting = FitWeighting::parse(weighting);
         opt.cacheDir = cache;
-        namespace fs = std::filesystem;
+        opt.coherent = tracer == "coherent";
+        ShardSlice slice;
+        if (!shardText.empty()) {
+            slice = parseShard(shardText, std::getenv("SLURM_ARRAY_TASK_ID"));
+            if (targetError > 0)
+                throw InputError("--target-error cannot be combined with --shard: run the search "
+                                 "once, then shard with the --order, --rate and --grid it chose");
+        }
+        if (workDir.empty()) workDir = output + ".work";
         fs::path outDir = fs::absolute(output).parent_path();
         if (!fs::is_directory(outDir))
             throw inputError(output, "output folder " + outDir.string() + " does not exist");
@@ -122,7 +152,9 @@ int main(int argc, char** argv) {
             opt.progress = [&](const BakeProgress& p) {
                 double f = double(p.samplesDone) / std::max<size_t>(1, p.samplesTotal);
                 double rps = p.rays / std::max(1e-9, p.seconds);
-                double eta = f > 0 ? p.seconds * (1 - f) / f : 0;
+                // This run's pace over the samples it has done (not the resumed ones).
+                double g = double(p.samplesDone - p.samplesResumed) / std::max<size_t>(1, p.samplesTotal);
+                double eta = g > 0 ? p.seconds * (1 - f) / g : 0;
                 if (tty) {
                     int filled = static_cast<int>(f * 30);
                     std::fprintf(stderr, "\r[%-30s] %5.1f%%  %zu/%zu samples  %6.2f Mrays/s  ETA %s ",
@@ -139,10 +171,63 @@ int main(int argc, char** argv) {
         std::signal(SIGTERM, onSignal);
         opt.cancel = &gCancel;
 
-        BakeResult res = bake(scene, opt, input);
+        auto note = [&](const std::string& text) {
+            if (!quiet) std::fprintf(stderr, "%s%s\n", tty ? "\r" : "", text.c_str());
+        };
+        BakePlan plan(scene, opt, input);
+        if (resume) {
+            const int stale = removeStaleTemporaries(output);
+            if (stale > 0) note("resume: removed " + std::to_string(stale) + " temporary file(s) a killed bake left");
+        }
+        if (!shardText.empty()) {
+            // One slice into a shard file, for shrefract-merge.
+            if (resume && fs::exists(output)) {
+                try {
+                    const ShardData old = readShard(output);
+                    if (shardMismatch(old, shardIdentity(plan), slice, plan.batchCount()).empty()) {
+                        std::printf("%s: slice %d of %d is already complete\n", output.c_str(),
+                                    slice.index, slice.count);
+                        return 0;
+                    }
+                } catch (const InputError& e) {
+                    note(std::string("baking it again: ") + e.what());
+                }
+            }
+            const ShardData shard = bakeShard(plan, slice);
+            if (!quiet && tty) std::fprintf(stderr, "\n");
+            writeShard(output, shard);
+            const BakeStats st = BakeStats::fromJson(shard.manifest["stats"]);
+            std::printf("baked %s slice %d of %d -> %s\n", input.c_str(), slice.index, slice.count,
+                        output.c_str());
+            std::printf("  samples     %zu of %zu (from %zu), paths %zu, rays %zu\n", shard.sampleCount,
+                        plan.sampleCount(), shard.manifest["shard"].value("first", size_t(0)), st.paths,
+                        st.rays);
+            std::printf("  time        %.1f s wall (layout %.1f s, slice %.1f s)\n",
+                        std::chrono::duration<double>(Clock::now() - start).count(), plan.setupSeconds(),
+                        st.wallSeconds);
+            return 0;
+        }
+        const int nCheckpoints = checkpointCount(plan, checkpoints);
+        BakeResult res;
+        if (nCheckpoints <= 1) {
+            SliceResult all = plan.bakeSlice(0, plan.batchCount());
+            res.stats = all.stats;
+            res.data = plan.data(std::move(all.weights), res.stats);
+        } else {
+            CheckpointOptions co;
+            co.workDir = workDir;
+            co.count = nCheckpoints;
+            co.resume = resume;
+            co.log = note;
+            checkpointDir = workDir;
+            res = bakeWithCheckpoints(plan, co);
+        }
+        res.stats.rhoOverhead = rhoOverhead(plan.layout());
         if (!quiet && tty) std::fprintf(stderr, "\n");
         if (gCancel) throw Cancelled();
         writeBake(output, res.data);
+        if (nCheckpoints > 1) removeCheckpoints(workDir);
+        res.stats.wallSeconds = std::chrono::duration<double>(Clock::now() - start).count();
 
         const BakeStats& s = res.stats;
         auto pct = [&](size_t k) { return 100.0 * double(k) / double(std::max<size_t>(1, s.paths)); };
@@ -153,8 +238,12 @@ int main(int argc, char** argv) {
                     s.rhoOverhead);
         std::printf("  paths       %zu (%d directions), rays %zu (%.2f per path)\n", s.paths,
                     opt.grid.count(), s.rays, double(s.rays) / std::max<size_t>(1, s.paths));
-        std::printf("  time        %.1f s wall (trace %.1f s, compress %.1f s thread time), %.2f Mrays/s\n",
-                    s.wallSeconds, s.traceSeconds, s.compressSeconds, s.rays / s.wallSeconds * 1e-6);
+        if (nCheckpoints <= 1)
+            std::printf("  time        %.1f s wall (trace %.1f s, compress %.1f s thread time), %.2f Mrays/s\n",
+                        s.wallSeconds, s.traceSeconds, s.compressSeconds, s.rays / s.wallSeconds * 1e-6);
+        else
+            std::printf("  time        %.1f s wall, %d checkpoints (%.1f s of slices in all runs)\n",
+                        s.wallSeconds, nCheckpoints, res.data.manifest["stats"].value("seconds", 0.0));
         std::printf("  paths with  TIR %.2f%%, capped %.3f%% (soft %.3f%%), left and re-entered %.2f%%, "
                     "geometric-normal fallback %.3f%%, leaked %.3f%%\n",
                     pct(s.tir), pct(s.capped), pct(s.softCapped), pct(s.reentered), pct(s.geometricNormal),
@@ -165,6 +254,9 @@ int main(int argc, char** argv) {
         return 0;
     } catch (const Cancelled&) {
         std::fprintf(stderr, "\nshrefract-bake: cancelled; no file written\n");
+        if (!checkpointDir.empty())
+            std::fprintf(stderr, "shrefract-bake: finished checkpoints stay in %s: run the same "
+                                 "command with --resume to continue\n", checkpointDir.c_str());
         return 130;
     } catch (const InputError& e) {
         std::fprintf(stderr, "shrefract-bake: error: %s\n", e.what());

@@ -87,10 +87,12 @@ TEST(BakeCli, BadInputKeepsAnExistingOutputFile) {
 
 namespace {
 
-// Ctrl-C (SIGINT) mid-bake: a clean stop, exit 130, no output file and no temporary left.
+// Ctrl-C (SIGINT) mid-bake: a clean stop, exit 130, no output file and no temporary left; the
+// checkpoints finished so far (none after a second) stay for --resume.
 TEST(BakeCli, InterruptStopsCleanlyAndWritesNothing) {
     const std::string out = tmp("interrupted.shrefract.exr");
     fs::remove(out);
+    fs::remove_all(out + ".work");
     // knot1 at rate 3 takes tens of seconds: long enough to interrupt after one.
     const std::string cmd = "sh -c '" + kBake + " " + std::string(SHREFRACT_DATA_DIR) +
                             "/meshes/knot1.off -o " + out +
@@ -98,7 +100,9 @@ TEST(BakeCli, InterruptStopsCleanlyAndWritesNothing) {
     CommandResult r = run(cmd);
     EXPECT_EQ(r.code, 130) << r.out;
     EXPECT_NE(r.out.find("cancelled"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("--resume"), std::string::npos) << r.out;
     EXPECT_FALSE(fs::exists(out));
+    fs::remove_all(out + ".work");
     for (auto& e : fs::directory_iterator(SHREFRACT_TEST_TMP))
         EXPECT_NE(e.path().string().rfind(out + ".tmp", 0), 0u) << "left behind: " << e.path();
 }

@@ -11,6 +11,7 @@
 #include "bake/tracer.h"
 #include "common/bakefile.h"
 #include "common/direction_grid.h"
+#include "common/error.h"
 #include "common/scene.h"
 
 namespace shrefract {
@@ -57,10 +58,6 @@ struct BakeStats {
 struct BakeResult {
     BakeData data;
     BakeStats stats;
-};
-
-struct Cancelled : std::runtime_error {
-    Cancelled() : std::runtime_error("cancelled") {}
 };
 
 // `inputPath` is recorded in the manifest so evaluation can re-trace the same scene.

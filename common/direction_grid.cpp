@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "common/error.h"
+#include "common/output.h"
 #include "common/sh.h"
 
 namespace shrefract {
@@ -99,13 +100,11 @@ bool readCache(const std::string& path, const DirectionGrid& g, int L, int q, Ei
     return true;
 }
 
-// Writes to a unique temporary name in the same directory, then renames: readers never see a
-// half-written file, and concurrent writers of the same matrix just race to identical content.
+// Writes through writeAtomically (common/output.h): readers never see a half-written file, a
+// killed bake leaves no temporary, and concurrent writers of the same matrix just race to
+// identical content. A cache that cannot be written is no error: returns false.
 bool writeCache(const std::string& path, const DirectionGrid& g, int L, int q,
                 const Eigen::MatrixXd& M) {
-    static std::atomic<int> counter{0};
-    std::string tmp =
-        path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter.fetch_add(1));
     CacheHeader h;
     std::memcpy(h.magic, kCacheMagic, 8);
     h.L = L;
@@ -115,21 +114,14 @@ bool writeCache(const std::string& path, const DirectionGrid& g, int L, int q,
     h.rows = M.rows();
     h.cols = M.cols();
     h.checksum = fnv1a(M.data(), size_t(M.size()) * sizeof(double));
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        out.write(reinterpret_cast<const char*>(&h), sizeof h);
-        out.write(reinterpret_cast<const char*>(M.data()),
-                  std::streamsize(M.size() * sizeof(double)));
-        if (!out.good()) {
-            out.close();
-            std::remove(tmp.c_str());
-            return false;
-        }
+    std::string bytes(reinterpret_cast<const char*>(&h), sizeof h);
+    bytes.append(reinterpret_cast<const char*>(M.data()), size_t(M.size()) * sizeof(double));
+    try {
+        writeFile(path, bytes);
+        return true;
+    } catch (const std::exception&) {
+        return false;
     }
-    std::error_code ec;
-    std::filesystem::rename(tmp, path, ec);
-    if (ec) std::remove(tmp.c_str());
-    return !ec;
 }
 
 }  // namespace

@@ -17,11 +17,8 @@
 #include <ImfMultiPartOutputFile.h>
 #include <ImfOutputPart.h>
 #include <ImfPartType.h>
-#include <ImfStdIO.h>
 #include <ImfStringAttribute.h>
-#include <fcntl.h>
 #include <half.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -39,6 +36,8 @@
 #include "common/bakefile.h"
 #include "common/checksum.h"
 #include "common/error.h"
+#include "common/exr_output.h"
+#include "common/output.h"
 #include "common/sh.h"
 
 namespace shrefract {
@@ -406,14 +405,6 @@ void writeWeights(Imf::MultiPartOutputFile& file, int part, const BakeData& d, c
     }
 }
 
-// Flushes the file's data to disk before the rename makes it visible under its final name.
-void syncFile(const std::string& path) {
-    const int fd = ::open(path.c_str(), O_RDONLY);
-    if (fd < 0) return;
-    ::fsync(fd);
-    ::close(fd);
-}
-
 // ---------------------------------------------------------------------------------------------
 // Reading.
 
@@ -769,33 +760,16 @@ void writeBake(const std::string& path, const BakeData& data) {
     addChannels(headers[3], kNeighbourChannels);
     addChannels(headers[4], kNeighbourListChannels);
 
-    const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-    try {
-        std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
-        if (!os) throw inputError(path, str("cannot create ", tmp, ": ", std::strerror(errno)));
-        {
-            Imf::StdOFStream stream(os, tmp.c_str());
+    writeAtomically(path, [&](const std::string& staged) {
+        writeExrFile(staged, [&](Imf::OStream& stream) {
             Imf::MultiPartOutputFile file(stream, headers.data(), int(headers.size()));
             writeWeights(file, 0, data, u8);
             writeWhole(file, 1, samples, L.muHeight);
             writeWhole(file, 2, rho, L.rhoHeight);
             writeWhole(file, 3, neighbours, L.muHeight);
             writeWhole(file, 4, list, nlHeight);
-        }  // the destructor writes the chunk offset tables; it swallows errors, the stream not
-        os.flush();
-        os.close();
-        if (os.fail())
-            throw inputError(path, str("cannot write ", tmp, ": ", std::strerror(errno)));
-        syncFile(tmp);
-        if (std::rename(tmp.c_str(), path.c_str()) != 0)
-            throw inputError(path, str("cannot rename ", tmp, " to it: ", std::strerror(errno)));
-    } catch (const Iex::BaseExc& e) {
-        std::remove(tmp.c_str());
-        throw inputError(path, str("cannot write: ", e.what()));
-    } catch (...) {
-        std::remove(tmp.c_str());
-        throw;
-    }
+        });
+    });
 }
 
 BakeData readBake(const std::string& path, const ReadOptions& options) {

@@ -16,7 +16,9 @@
 #include "bake/bake.h"
 #include "bake/cmd/common_cli.h"
 #include "bake/layout.h"
+#include "common/cli/cli.h"
 #include "common/frame.h"
+#include "common/output.h"
 #include "common/sh.h"
 
 using namespace shrefract;
@@ -34,93 +36,93 @@ int main(int argc, char** argv) {
     app.add_option("--order", order)->capture_default_str();
     app.add_option("--stride", stride, "ceiling measured on every stride-th sample")->capture_default_str();
     app.add_option("--json", json)->capture_default_str();
-    CLI11_PARSE(app, argc, argv);
+    return cli::run(app, "shrefract-bench-bake", argc, argv, [&] {
+        Scene scene = loadScene(input);
+        BakeOptions opt;
+        opt.samples = samples;
+        opt.order = order;
+        opt.cacheDir = cli::defaultCacheDir();
 
-    Scene scene = loadScene(input);
-    BakeOptions opt;
-    opt.samples = samples;
-    opt.order = order;
-    opt.cacheDir = cli::defaultCacheDir();
+        // 1. The whole bake, as shrefract-bake runs it.
+        BakeResult res = bake(scene, opt, input);
+        const BakeStats& st = res.stats;
+        rusage ru;
+        getrusage(RUSAGE_SELF, &ru);
+        const double peakMB = ru.ru_maxrss / 1024.0;
 
-    // 1. The whole bake, as shrefract-bake runs it.
-    BakeResult res = bake(scene, opt, input);
-    const BakeStats& st = res.stats;
-    rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
-    const double peakMB = ru.ru_maxrss / 1024.0;
+        // 2. Ceiling: the rays of a subset of samples, logged, then replayed through a bare loop.
+        const SurfaceLayout& L = res.data.layout;
+        Tracer tracer(scene, opt.trace);
+        std::vector<int> subset;
+        for (int i = 0; i < L.sampleCount(); i += stride) subset.push_back(i);
+        const int J = opt.grid.count();
+        std::vector<glm::vec3> dirs(J);
+        for (int j = 0; j < J; ++j) dirs[j] = glm::vec3(opt.grid.direction(j));
+        std::vector<std::vector<LoggedRay>> logs(subset.size());
+        tbb::parallel_for(size_t(0), subset.size(), [&](size_t s) {
+            enableFlushToZero();
+            int i = subset[s];
+            Frame f = Frame::fromNormal(L.normal[i]);
+            for (int j = 0; j < J; ++j) tracer.trace(L.position[i], L.normal[i], f.fromLocal(dirs[j]), L.part[i], &logs[s]);
+        });
+        size_t subsetRays = 0;
+        for (auto& l : logs) subsetRays += l.size();
+        // Full tracing of the subset (no logging) ...
+        auto t0 = Clock::now();
+        tbb::parallel_for(size_t(0), subset.size(), [&](size_t s) {
+            enableFlushToZero();
+            int i = subset[s];
+            Frame f = Frame::fromNormal(L.normal[i]);
+            for (int j = 0; j < J; ++j) tracer.trace(L.position[i], L.normal[i], f.fromLocal(dirs[j]), L.part[i]);
+        });
+        const double traceSec = since(t0);
+        // ... against the bare loop over the same rays.
+        t0 = Clock::now();
+        std::atomic<size_t> hits{0};
+        tbb::parallel_for(size_t(0), subset.size(), [&](size_t s) {
+            enableFlushToZero();
+            size_t h = 0;
+            float t;
+            for (const LoggedRay& r : logs[s]) h += tracer.intersect(r.org, r.dir, &t);
+            hits += h;
+        });
+        const double bareSec = since(t0);
 
-    // 2. Ceiling: the rays of a subset of samples, logged, then replayed through a bare loop.
-    const SurfaceLayout& L = res.data.layout;
-    Tracer tracer(scene, opt.trace);
-    std::vector<int> subset;
-    for (int i = 0; i < L.sampleCount(); i += stride) subset.push_back(i);
-    const int J = opt.grid.count();
-    std::vector<glm::vec3> dirs(J);
-    for (int j = 0; j < J; ++j) dirs[j] = glm::vec3(opt.grid.direction(j));
-    std::vector<std::vector<LoggedRay>> logs(subset.size());
-    tbb::parallel_for(size_t(0), subset.size(), [&](size_t s) {
-        enableFlushToZero();
-        int i = subset[s];
-        Frame f = Frame::fromNormal(L.normal[i]);
-        for (int j = 0; j < J; ++j) tracer.trace(L.position[i], L.normal[i], f.fromLocal(dirs[j]), L.part[i], &logs[s]);
+        // 3. Compression: the bake's GEMM thread time against a bare GEMM of the same shape.
+        const int K = shEvenCount(order), cols = 4 * 32;
+        // The same shape and operand order as the bake: W^T (cols x K) = R^T (cols x J) M^T (J x K).
+        Eigen::MatrixXf Mt = Eigen::MatrixXf::Random(J, K), R = Eigen::MatrixXf::Random(J, cols), W(cols, K);
+        const size_t batches = (L.sampleCount() + 31) / 32;
+        t0 = Clock::now();
+        for (size_t b = 0; b < batches; ++b) {
+            W.noalias() = R.transpose() * Mt;
+            R(b % J, 0) += W(0, 0) * 1e-30f;  // keep the optimizer honest
+        }
+        const double gemmSec = since(t0);
+        const double flops = 2.0 * K * J * cols * batches;
+
+        const double bakeRps = st.rays / st.wallSeconds;
+        const double subsetRps = subsetRays / traceSec, bareRps = subsetRays / bareSec;
+        nlohmann::json out = {
+            {"mesh", input},
+            {"samples", st.samples},
+            {"directions", J},
+            {"order", order},
+            {"threads", tbb::this_task_arena::max_concurrency()},
+            {"bake", {{"seconds", st.wallSeconds}, {"paths", st.paths}, {"rays", st.rays},
+                      {"pathsPerSecond", st.paths / st.wallSeconds}, {"raysPerSecond", bakeRps},
+                      {"peakMemoryMB", peakMB}}},
+            {"ceiling", {{"samples", subset.size()}, {"rays", subsetRays},
+                         {"tracedRaysPerSecond", subsetRps}, {"bareEmbreeRaysPerSecond", bareRps},
+                         {"ratio", subsetRps / bareRps}, {"target", 0.8}}},
+            {"compression", {{"bakeGflops", flops / st.compressSeconds * 1e-9},
+                             {"bareGemmGflops", flops / gemmSec * 1e-9},
+                             {"ratio", gemmSec / st.compressSeconds}, {"target", 0.7},
+                             {"note", "bake: GEMM + scatter into the weight arrays, thread time; bare: GEMM alone, one thread"}}},
+            {"targets", {{"bakeUnder120s", st.wallSeconds < 120}}},
+        };
+        writeFile(json, out.dump(2) + "\n");
+        std::printf("%s\n", out.dump(2).c_str());
+        return cli::kOk;
     });
-    size_t subsetRays = 0;
-    for (auto& l : logs) subsetRays += l.size();
-    // Full tracing of the subset (no logging) ...
-    auto t0 = Clock::now();
-    tbb::parallel_for(size_t(0), subset.size(), [&](size_t s) {
-        enableFlushToZero();
-        int i = subset[s];
-        Frame f = Frame::fromNormal(L.normal[i]);
-        for (int j = 0; j < J; ++j) tracer.trace(L.position[i], L.normal[i], f.fromLocal(dirs[j]), L.part[i]);
-    });
-    const double traceSec = since(t0);
-    // ... against the bare loop over the same rays.
-    t0 = Clock::now();
-    std::atomic<size_t> hits{0};
-    tbb::parallel_for(size_t(0), subset.size(), [&](size_t s) {
-        enableFlushToZero();
-        size_t h = 0;
-        float t;
-        for (const LoggedRay& r : logs[s]) h += tracer.intersect(r.org, r.dir, &t);
-        hits += h;
-    });
-    const double bareSec = since(t0);
-
-    // 3. Compression: the bake's GEMM thread time against a bare GEMM of the same shape.
-    const int K = shEvenCount(order), cols = 4 * 32;
-    // The same shape and operand order as the bake: W^T (cols x K) = R^T (cols x J) M^T (J x K).
-    Eigen::MatrixXf Mt = Eigen::MatrixXf::Random(J, K), R = Eigen::MatrixXf::Random(J, cols), W(cols, K);
-    const size_t batches = (L.sampleCount() + 31) / 32;
-    t0 = Clock::now();
-    for (size_t b = 0; b < batches; ++b) {
-        W.noalias() = R.transpose() * Mt;
-        R(b % J, 0) += W(0, 0) * 1e-30f;  // keep the optimizer honest
-    }
-    const double gemmSec = since(t0);
-    const double flops = 2.0 * K * J * cols * batches;
-
-    const double bakeRps = st.rays / st.wallSeconds;
-    const double subsetRps = subsetRays / traceSec, bareRps = subsetRays / bareSec;
-    nlohmann::json out = {
-        {"mesh", input},
-        {"samples", st.samples},
-        {"directions", J},
-        {"order", order},
-        {"threads", tbb::this_task_arena::max_concurrency()},
-        {"bake", {{"seconds", st.wallSeconds}, {"paths", st.paths}, {"rays", st.rays},
-                  {"pathsPerSecond", st.paths / st.wallSeconds}, {"raysPerSecond", bakeRps},
-                  {"peakMemoryMB", peakMB}}},
-        {"ceiling", {{"samples", subset.size()}, {"rays", subsetRays},
-                     {"tracedRaysPerSecond", subsetRps}, {"bareEmbreeRaysPerSecond", bareRps},
-                     {"ratio", subsetRps / bareRps}, {"target", 0.8}}},
-        {"compression", {{"bakeGflops", flops / st.compressSeconds * 1e-9},
-                         {"bareGemmGflops", flops / gemmSec * 1e-9},
-                         {"ratio", gemmSec / st.compressSeconds}, {"target", 0.7},
-                         {"note", "bake: GEMM + scatter into the weight arrays, thread time; bare: GEMM alone, one thread"}}},
-        {"targets", {{"bakeUnder120s", st.wallSeconds < 120}}},
-    };
-    std::ofstream(json) << out.dump(2) << "\n";
-    std::printf("%s\n", out.dump(2).c_str());
-    return 0;
 }

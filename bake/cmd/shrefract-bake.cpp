@@ -2,23 +2,21 @@
 // A thin shell over bake/ (bake.h); options in docs/bake.md.
 #include <CLI/CLI.hpp>
 
-#include <atomic>
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 
 #include "bake/bake.h"
 #include "bake/layout.h"
 #include "bake/target.h"
 #include "bake/cmd/common_cli.h"
+#include "common/cli/cli.h"
 #include "common/error.h"
+#include "common/output.h"
 
 using namespace shrefract;
 
 namespace {
-std::atomic<bool> gCancel{false};
-void onSignal(int) { gCancel = true; }
+constexpr const char* kTool = "shrefract-bake";
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -65,9 +63,9 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(0.001, 180.0));
     app.add_option("--target-report", targetReport, "write the --target-error search as JSON");
     app.add_flag("-q,--quiet", quiet, "no progress output");
-    CLI11_PARSE(app, argc, argv);
-
-    try {
+    return cli::run(app, kTool, argc, argv, [&] {
+        // Stop cleanly on Ctrl-C or SIGTERM: the bake polls the flag, nothing is written.
+        opt.cancel = cli::cancelOnSignals();
         opt.rate = rate;
         opt.samples = samples;
         opt.grid = parseGrid(grid, "--grid");
@@ -76,10 +74,11 @@ int main(int argc, char** argv) {
         opt.fit = parseFit(fit);
         opt.weighting = FitWeighting::parse(weighting);
         opt.cacheDir = cache;
-        namespace fs = std::filesystem;
-        fs::path outDir = fs::absolute(output).parent_path();
-        if (!fs::is_directory(outDir))
-            throw inputError(output, "output folder " + outDir.string() + " does not exist");
+        // Every output checked and staged before the work: a bad path fails now, not after an
+        // hour of tracing, and nothing appears under its name until all are complete.
+        OutputSet outputs;
+        const std::string stagedBake = outputs.add(output);
+        const std::string stagedReport = targetReport.empty() ? "" : outputs.add(targetReport);
 
         Medium medium;
         medium.ior = ior;
@@ -102,11 +101,7 @@ int main(int argc, char** argv) {
             std::printf("  chosen: %.1f MB of weights (%.2fx less), %.3g paths (%.2fx less)\n", c.weightBytes / 1e6,
                         double(p.weightBytes) / std::max<size_t>(1, c.weightBytes), c.bakeCost,
                         p.bakeCost / std::max(1.0, c.bakeCost));
-            if (!targetReport.empty()) {
-                std::ofstream f(targetReport);
-                f << t.ToJson().dump(2) << "\n";
-                if (!f) throw inputError(targetReport, "cannot write");
-            }
+            if (!targetReport.empty()) writeFile(stagedReport, t.ToJson().dump(2) + "\n");
             opt.order = c.order;
             opt.rate = c.rate;
             opt.grid = c.grid;
@@ -131,14 +126,24 @@ int main(int argc, char** argv) {
                 }
             };
         }
-        std::signal(SIGINT, onSignal);
-        std::signal(SIGTERM, onSignal);
-        opt.cancel = &gCancel;
+        if (opt.rate == 0) {
+            // Say what --samples becomes: the smallest rate reaching it, usually more samples.
+            opt.rate = rateForSampleCount(scene, opt.samples);
+            const size_t n = joiningSampleCount(scene, opt.rate);
+            if (n != opt.samples)
+                cli::note(kTool, "--samples " + std::to_string(opt.samples) + ": rate " +
+                                     std::to_string(opt.rate) + " gives " + std::to_string(n) +
+                                     " unique samples (" +
+                                     (n > opt.samples ? "the smallest rate that reaches it"
+                                                      : "the largest rate; it cannot reach it") +
+                                     ")");
+        }
 
         BakeResult res = bake(scene, opt, input);
         if (!quiet && tty) std::fprintf(stderr, "\n");
-        if (gCancel) throw Cancelled();
-        writeBake(output, res.data);
+        writeBake(stagedBake, res.data);
+        if (opt.cancel->load()) throw Cancelled();  // a signal during the write: keep nothing
+        outputs.commit();
 
         const BakeStats& s = res.stats;
         auto pct = [&](size_t k) { return 100.0 * double(k) / double(std::max<size_t>(1, s.paths)); };
@@ -158,15 +163,6 @@ int main(int argc, char** argv) {
         std::printf("  file        %.1f MB, order %d, %d coefficients, %s\n",
                     std::filesystem::file_size(output) / 1e6, opt.order, res.data.coefficientCount(),
                     precision.c_str());
-        return 0;
-    } catch (const Cancelled&) {
-        std::fprintf(stderr, "\nshrefract-bake: cancelled; no file written\n");
-        return 130;
-    } catch (const InputError& e) {
-        std::fprintf(stderr, "shrefract-bake: error: %s\n", e.what());
-        return 2;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "shrefract-bake: error: %s\n", e.what());
-        return 1;
-    }
+        return cli::kOk;
+    });
 }

@@ -5,7 +5,8 @@
 //                    [--method sh|single|wyman|raytrace] [--wyman-tir reflect|straight|grazing]
 // A thin shell over the runtime library (shrefract/render.h, shrefract/baselines.h) and, for
 // raytrace and Wyman's d_N, the evaluation layer (eval/reference.h, Embree through bake/): the
-// runtime library itself never links the bake. Bad input: message, exit 1, and no output file.
+// runtime library itself never links the bake. Every output is checked before the render and
+// written only when all succeed (common/output.h); exit codes as every tool's (README).
 #include <algorithm>
 #include <cstdio>
 #include <sstream>
@@ -13,8 +14,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include "common/cli/cli.h"
 #include "common/error.h"
 #include "common/evalbuffer.h"
+#include "common/output.h"
 #include "shrefract/baselines.h"
 #include "shrefract/context.h"
 #include "shrefract/render.h"
@@ -95,9 +98,12 @@ int main(int argc, char** argv) {
                    "raytrace, wyman: the baked mesh or scene, if not where the manifest says");
     app.add_option("--dump-shaders", dumpDir, "write the generated GLSL into DIR");
     app.add_flag("--no-verify", noVerify, "skip the bake's checksums (faster; a corrupt file may draw garbage)");
-    CLI11_PARSE(app, argc, argv);
-
-    try {
+    return shrefract::cli::run(app, "shrefract-render", argc, argv, [&] {
+        // Outputs first: a path that cannot be written fails before any rendering.
+        shrefract::OutputSet outputs;
+        const std::string stagedPng = out.empty() ? "" : outputs.add(out);
+        const std::string stagedExr = outExr.empty() ? "" : outputs.add(outExr);
+        const std::string stagedDirs = dirs.empty() ? "" : outputs.add(dirs);
         int width = 0, height = 0;
         char x = 0;
         std::istringstream sizeStream(size);
@@ -133,6 +139,10 @@ int main(int argc, char** argv) {
         shrefract::Bake bake = shrefract::loadBake(bakePath, !noVerify);
         for (const std::string& w : bake.warnings())
             std::fprintf(stderr, "shrefract-render: warning: %s: %s\n", bakePath.c_str(), w.c_str());
+        if (order < -1 || order > bake.order())
+            throw std::invalid_argument("--order " + std::to_string(order) + ": " + bakePath +
+                                        " stores orders 0.." + std::to_string(bake.order()) +
+                                        " (-1: all)");
         shrefract::RenderedFrame frame;
         frame.width = width;
         frame.height = height;
@@ -251,14 +261,12 @@ int main(int argc, char** argv) {
         size_t covered = 0;
         for (size_t i = 3; i < frame.directions.size(); i += 4) covered += frame.directions[i] > 0;
         std::printf("coverage: %.1f%% of pixels\n", 100.0 * covered / (size_t(width) * height));
-        if (!out.empty()) shrefract::writePng(out, frame, exposure);
-        if (!outExr.empty()) shrefract::writeExr(outExr, width, height, frame.color);
+        if (!out.empty()) shrefract::writePng(stagedPng, frame, exposure);
+        if (!outExr.empty()) shrefract::writeExr(stagedExr, width, height, frame.color);
         if (!dirs.empty())
             shrefract::writeEvalBuffer(
-                dirs, shrefract::makeEvalBuffer(width, height, frame.color, frame.directions));
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "shrefract-render: %s\n", e.what());
-        return 1;
-    }
-    return 0;
+                stagedDirs, shrefract::makeEvalBuffer(width, height, frame.color, frame.directions));
+        outputs.commit();  // all or none
+        return shrefract::cli::kOk;
+    });
 }

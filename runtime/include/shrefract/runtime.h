@@ -45,9 +45,11 @@ Bake makeBake(BakeData data);
 // Lat-long convention: +y up; u = 0.5 + atan2(d.x, -d.z) / 2pi, v = acos(d.y) / pi (row 0 top).
 class Environment {
 public:
-    // Loads a lat-long EXR into a cube map of `faceSize` (0: height / 2); throws InputError.
+    // Loads a lat-long EXR into a cube map of `faceSize` (0: height / 2); throws InputError naming
+    // the file: missing, not an image, a bake, not 2:1 (+-1 pixel), NaN or inf pixels.
     static Environment loadLatLong(const std::string& path, int faceSize = 0);
-    // Builds the cube map from lat-long RGB floats, row-major, row 0 = top (+y).
+    // Builds the cube map from lat-long RGB floats, row-major, row 0 = top (+y): 2:1 (+-1 pixel),
+    // every value finite, else std::invalid_argument.
     static Environment fromLatLong(int width, int height, const std::vector<float>& rgb,
                                    int faceSize = 0);
     Environment(Environment&&) noexcept;

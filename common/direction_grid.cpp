@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "common/error.h"
+#include "common/limits.h"
 #include "common/output.h"
 #include "common/sh.h"
 
@@ -223,10 +224,18 @@ DirectionGrid parseGrid(const std::string& text, const std::string& what) {
     DirectionGrid g;
     g.nTheta = std::stoi(text.substr(0, x));
     g.nPhi = std::stoi(text.substr(x + 1));
-    if (g.nTheta < 2 || g.nTheta > 1024 || g.nPhi < 2 || g.nPhi > 1024)
-        throw bad("counts must lie in [2, 1024]");
-    if (g.nPhi % 2 != 0) throw bad("NPHI must be even (the pole reflection maps phi to phi + pi)");
+    const std::string problem = gridProblem(g.nTheta, g.nPhi);
+    if (!problem.empty()) throw bad(problem);
     return g;
+}
+
+std::string gridProblem(int nTheta, int nPhi) {
+    if (nTheta < limits::kMinGrid || nTheta > limits::kMaxGrid || nPhi < limits::kMinGrid ||
+        nPhi > limits::kMaxGrid)
+        return "counts must lie in [" + std::to_string(limits::kMinGrid) + ", " +
+               std::to_string(limits::kMaxGrid) + "]";
+    if (nPhi % 2 != 0) return "NPHI must be even (the pole reflection maps phi to phi + pi)";
+    return "";
 }
 
 Eigen::MatrixXd compressionMatrix(const DirectionGrid& grid, int L, int q) {

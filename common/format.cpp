@@ -35,9 +35,12 @@
 
 #include "common/bakefile.h"
 #include "common/checksum.h"
+#include "common/direction_grid.h"
 #include "common/error.h"
 #include "common/exr_output.h"
+#include "common/limits.h"
 #include "common/output.h"
+#include "common/scene.h"
 #include "common/sh.h"
 
 namespace shrefract {
@@ -174,6 +177,10 @@ std::vector<Channel> weightChannels(int K, Precision p) {
     }
     return ch;
 }
+// Bytes of one weights texel: 16 per coefficient in f32, 8 in f16, 4 in u8.
+uint64_t weightsTexelBytes(int K, Precision p) {
+    return uint64_t(K) * (p == Precision::U8 ? 4 : p == Precision::F16 ? 8 : 16);
+}
 const std::vector<Channel> kSampleChannels = {
     {"P.x", Imf::FLOAT}, {"P.y", Imf::FLOAT}, {"P.z", Imf::FLOAT}, {"N.x", Imf::FLOAT},
     {"N.y", Imf::FLOAT}, {"N.z", Imf::FLOAT}, {"part", Imf::UINT}};
@@ -257,7 +264,8 @@ std::string str(const T&... parts) {
 
 std::string inconsistency(const BakeData& d) {
     const SurfaceLayout& L = d.layout;
-    if (d.order < 0) return str("order ", d.order, " is negative");
+    if (d.order < 0 || d.order > limits::kMaxOrder)
+        return str("SH order ", d.order, " is not in [0, ", limits::kMaxOrder, "]");
     const size_t K = size_t(d.coefficientCount());
     const size_t N = L.position.size();
     if (L.normal.size() != N || L.part.size() != N)
@@ -271,7 +279,11 @@ std::string inconsistency(const BakeData& d) {
         return str("rho layout is ", L.rhoWidth, " x ", L.rhoHeight, " texels");
     if (L.rho.size() != size_t(L.rhoWidth) * size_t(L.rhoHeight))
         return str("rho has ", L.rho.size(), " texels, expected ", L.rhoWidth, " x ", L.rhoHeight);
-    if (L.rate < 1) return str("rate ", L.rate, " is below 1");
+    if (L.rate < 1 || L.rate > limits::kMaxRate)
+        return str("rate ", L.rate, " is not in [1, ", limits::kMaxRate, "]");
+    for (int side : {L.muWidth, L.muHeight, L.rhoWidth, L.rhoHeight})
+        if (side > limits::kMaxTextureSize)
+            return str("a layout side of ", side, " texels is above ", limits::kMaxTextureSize);
     if (L.triangleCount < 0) return str("triangle count ", L.triangleCount, " is negative");
     if (L.triangleCount > 0) {
         if (L.blockWidth < 1 || L.blockHeight < 1 || L.blocksPerRow < 1)
@@ -284,6 +296,13 @@ std::string inconsistency(const BakeData& d) {
             return str(L.triangleCount, " triangles in ", L.blockWidth, " x ", L.blockHeight,
                        " blocks, ", L.blocksPerRow, " per row, do not fit the ", L.rhoWidth, " x ",
                        L.rhoHeight, " rho layout");
+        // A block holds an upright triangle's samples (i + j <= r) and corrections (r + 1), and
+        // its rotated partner's, without the two meeting (docs/format.md "rho").
+        const int r = L.rate;
+        if (L.blockWidth < r + 1 || L.blockHeight < r + 1 || L.blockWidth + L.blockHeight < 2 * r + 5)
+            return str("rho blocks of ", L.blockWidth, " x ", L.blockHeight,
+                       " texels cannot hold two triangles at rate ", r);
+        if (N == 0) return str(L.triangleCount, " triangles but no samples");
     }
     for (size_t t = 0; t < L.rho.size(); ++t) {
         const RhoTexel& r = L.rho[t];
@@ -295,6 +314,29 @@ std::string inconsistency(const BakeData& d) {
         if (bad)
             return str("rho texel (", x, ", ", y, ") refers to samples (", r.a, ", ", r.b, ", ",
                        r.c, ") but there are only ", N);
+    }
+    // Every triangle's grid positions hold its samples, and the texels past its hypotenuse its
+    // corrections: what the runtime and queryBake look up (SurfaceLayout::sampleAt).
+    for (int t = 0; t < L.triangleCount; ++t) {
+        for (int j = 0; j <= L.rate + 1; ++j)
+            for (int i = 0; i + j <= L.rate + 1; ++i) {
+                const bool correction = i + j == L.rate + 1;
+                if (correction && (i == 0 || j == 0)) continue;
+                const glm::ivec2 x = L.rhoTexel(t, i, j);
+                const uint32_t kind = L.rho[size_t(x.y) * size_t(L.rhoWidth) + size_t(x.x)].kind;
+                if (kind != (correction ? RhoTexel::Correction : RhoTexel::Sample))
+                    return str("triangle ", t, "'s ", correction ? "correction" : "sample",
+                               " texel (", i, ", ", j, ") at rho (", x.x, ", ", x.y,
+                               ") has kind ", kind);
+            }
+    }
+    for (size_t i = 0; i < N; ++i) {
+        const glm::vec3 p = L.position[i], n = L.normal[i];
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+            return str("sample ", i, " has a non-finite position");
+        const float len = glm::length(n);
+        if (!(std::fabs(len - 1.0f) < 1e-3f))
+            return str("sample ", i, " has a normal of length ", len, ", not a unit vector");
     }
     if (L.neighbourOffset.size() != N || L.neighbourCount.size() != N)
         return str("neighbour offsets (", L.neighbourOffset.size(), ") and counts (",
@@ -311,10 +353,27 @@ std::string inconsistency(const BakeData& d) {
         if (L.neighbourIndex[e] >= N)
             return str("neighbour list entry ", e, " refers to sample ", L.neighbourIndex[e],
                        " but there are only ", N);
+        if (!std::isfinite(L.neighbourWeight[e]))
+            return str("neighbour list entry ", e, " has a non-finite weight");
+    }
+    // Smoothing averages a sample with its neighbours: itself first, weights summing to 1.
+    for (size_t i = 0; i < N; ++i) {
+        if (L.neighbourCount[i] == 0) continue;
+        if (L.neighbourIndex[L.neighbourOffset[i]] != i)
+            return str("the neighbour list of sample ", i, " does not start with the sample itself");
+        double sum = 0;
+        for (uint32_t k = 0; k < L.neighbourCount[i]; ++k)
+            sum += L.neighbourWeight[L.neighbourOffset[i] + k];
+        if (!(std::fabs(sum - 1.0) < 1e-3))
+            return str("the neighbour weights of sample ", i, " sum to ", sum, ", not 1");
     }
     if (d.weights.size() != K * N * 4)
         return str(d.weights.size(), " weights, expected ", K, " coefficients x ", N,
                    " samples x 4");
+    for (size_t v = 0; v < d.weights.size(); ++v)
+        if (!std::isfinite(d.weights[v]))
+            return str("weight ", v / (4 * N), " of sample ", (v / 4) % N, " channel ",
+                       kWeightSuffix[v % 4], " is not finite");
     return "";
 }
 
@@ -408,9 +467,15 @@ void writeWeights(Imf::MultiPartOutputFile& file, int part, const BakeData& d, c
 // ---------------------------------------------------------------------------------------------
 // Reading.
 
+bool fitsInt(const json& x) {
+    if (!x.is_number_integer()) return false;
+    if (x.is_number_unsigned()) return x.get<uint64_t>() <= uint64_t(INT32_MAX);
+    return x.get<int64_t>() >= INT32_MIN && x.get<int64_t>() <= INT32_MAX;
+}
+
 int manifestInt(const json& m, const char* key) {
     auto it = m.find(key);
-    if (it == m.end() || !it->is_number_integer())
+    if (it == m.end() || !fitsInt(*it))
         throw InputError(str("manifest has no integer \"", key, "\""));
     return it->get<int>();
 }
@@ -421,7 +486,7 @@ std::vector<int> manifestInts(const json& m, const char* key, size_t n) {
         throw InputError(str("manifest has no \"", key, "\" array of ", n, " integers"));
     std::vector<int> v;
     for (const json& x : *it) {
-        if (!x.is_number_integer())
+        if (!fitsInt(x))
             throw InputError(str("manifest has no \"", key, "\" array of ", n, " integers"));
         v.push_back(x.get<int>());
     }
@@ -438,6 +503,65 @@ std::vector<double> manifestNumbers(const json& m, const char* key, size_t n) {
         v.push_back(x.get<double>());
     }
     return v;
+}
+
+// The descriptive keys that tools act on (evaluation re-traces with the media, grid, branch and
+// bounce cap; the runtime shades with media[0]), checked as shrefract-bake checks its options and
+// a scene its media (common/limits.h, mediumProblem): a manifest that says IOR 0 is refused, not
+// rendered as a mirror. Keys a bake may lack are checked only when present. Returns what is
+// wrong, or "".
+std::string manifestProblem(const json& m) {
+    if (auto it = m.find("media"); it != m.end()) {
+        if (!it->is_array()) return "\"media\" is not an array";
+        for (size_t i = 0; i < it->size(); ++i) {
+            const json& md = (*it)[i];
+            const std::string where = str("media[", i, "]");
+            if (!md.is_object()) return where + " is not an object";
+            Medium medium;
+            if (md.contains("ior")) {
+                if (!md["ior"].is_number()) return where + ": 'ior' is not a number";
+                medium.ior = md["ior"].get<double>();
+            }
+            if (md.contains("absorption")) {
+                const json& a = md["absorption"];
+                if (!a.is_array() || a.size() != 3) return where + ": 'absorption' is not 3 numbers";
+                for (int c = 0; c < 3; ++c) {
+                    if (!a[c].is_number()) return where + ": 'absorption' is not 3 numbers";
+                    medium.absorption[c] = a[c].get<double>();
+                }
+            }
+            if (md.contains("priority") && !md["priority"].is_number_integer())
+                return where + ": 'priority' is not an integer";
+            for (const char* key : {"name", "mesh", "meshChecksum"})
+                if (md.contains(key) && !md[key].is_string())
+                    return str(where, ": '", key, "' is not a string");
+            const std::string problem = mediumProblem(medium);
+            if (!problem.empty()) return where + ": " + problem;
+        }
+    }
+    if (auto it = m.find("grid"); it != m.end() && it->is_array()) {
+        if (it->size() != 2 || !(*it)[0].is_number_integer() || !(*it)[1].is_number_integer())
+            return "\"grid\" is not [nTheta, nPhi]";
+        const std::string problem = gridProblem((*it)[0].get<int>(), (*it)[1].get<int>());
+        if (!problem.empty()) return "\"grid\": " + problem;
+    }
+    if (auto it = m.find("filterWidth"); it != m.end()) {
+        if (!it->is_number() || !(it->get<double>() >= 0.0) ||
+            it->get<double>() > limits::kMaxFilterWidth)
+            return str("\"filterWidth\" ", it->dump(), " is not in [0, ", limits::kMaxFilterWidth, "]");
+    }
+    if (auto it = m.find("maxBounces"); it != m.end()) {
+        if (!it->is_number_integer() || it->get<int64_t>() < 1 ||
+            it->get<int64_t>() > limits::kMaxBounces)
+            return str("\"maxBounces\" ", it->dump(), " is not in [1, ", limits::kMaxBounces, "]");
+    }
+    if (auto it = m.find("branch"); it != m.end()) {
+        if (*it != "fresnel" && *it != "transmit")
+            return str("\"branch\" ", it->dump(), " is not \"fresnel\" or \"transmit\"");
+    }
+    if (auto it = m.find("input"); it != m.end() && !it->is_string())
+        return "\"input\" is not a string";
+    return "";
 }
 
 // Checks that `part` is a scanline part of width x height with the channels (and types) given.
@@ -511,7 +635,8 @@ std::string manifestText(Imf::MultiPartInputFile& file, int version, bool verify
     return text->value();
 }
 
-BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
+// `fileBytes`: the file's size, which bounds what its parts can decode to.
+BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options, uint64_t fileBytes) {
     // The manifest of the first part is the one that counts. Its version decides how it is
     // verified, so it is parsed once unverified, then taken again through its checksum.
     const auto* raw = file.header(0).findTypedAttribute<Imf::StringAttribute>(kManifestAttribute);
@@ -543,7 +668,10 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
 
     BakeData d;
     d.order = manifestInt(m, "order");
-    if (d.order < 0 || d.order > 100) throw InputError(str("SH order ", d.order, " is absurd"));
+    if (d.order < 0 || d.order > limits::kMaxOrder)
+        throw InputError(str("SH order ", d.order, " is not in [0, ", limits::kMaxOrder, "]"));
+    if (const std::string problem = manifestProblem(m); !problem.empty())
+        throw InputError("manifest: " + problem);
     const int K = d.coefficientCount();
     if (manifestInt(m, "coefficients") != K)
         throw InputError(str("manifest says ", manifestInt(m, "coefficients"),
@@ -571,6 +699,10 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
         throw InputError(
             str(N, " samples do not fit the ", L.muWidth, " x ", L.muHeight, " mu layout"));
     if (nlLength < 0) throw InputError(str("neighbour list length ", nlLength, " is negative"));
+    for (int side : {L.muWidth, L.muHeight, L.rhoWidth, L.rhoHeight, nlWidth})
+        if (side > limits::kMaxTextureSize)
+            throw InputError(str("manifest sizes are invalid: a side of ", side, " texels is above ",
+                                 limits::kMaxTextureSize));
     U8Params u8;
     if (d.precision == Precision::U8) {
         if (!m.contains("u8")) throw InputError("8-bit bake without \"u8\" scale and offset");
@@ -601,6 +733,15 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
     if (int64_t(nlWidth) * nlHeight < nlLength)
         throw InputError(str("neighbour list of ", nlLength, " entries does not fit its ", nlWidth,
                              " x ", nlHeight, " part"));
+    // zlib inflates at most ~1032:1, so the parts cannot hold more than ~1100 times the file's
+    // bytes: sizes beyond that are corrupt, and are refused before anything is allocated.
+    const uint64_t muTexels = uint64_t(L.muWidth) * uint64_t(L.muHeight);
+    const uint64_t pixelBytes = muTexels * weightsTexelBytes(K, d.precision) + muTexels * (28 + 8) +
+                                uint64_t(L.rhoWidth) * uint64_t(L.rhoHeight) * 16 +
+                                uint64_t(nlWidth) * uint64_t(std::max(nlHeight, 0)) * 8;
+    if (pixelBytes > 1100 * fileBytes + (1u << 20))
+        throw InputError(str("truncated or corrupt: its parts would hold ", pixelBytes,
+                             " bytes, more than a file of ", fileBytes, " bytes can"));
 
     // Weights, a band of rows at a time, dequantized to float. Verified, every row is read (the
     // checksum covers the padding past the last sample too).
@@ -670,6 +811,12 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
 
     const std::string problem = inconsistency(d);
     if (!problem.empty()) throw InputError("inconsistent bake: " + problem);
+    if (auto media = m.find("media"); media != m.end() && !media->empty()) {
+        for (int i = 0; i < N; ++i)
+            if (L.part[i] >= media->size())
+                throw InputError(str("inconsistent bake: sample ", i, " lies on part ", L.part[i],
+                                     " but the manifest has ", media->size(), " media"));
+    }
     d.manifest = std::move(m);
     d.warnings = std::move(warnings);
     return d;
@@ -778,6 +925,8 @@ BakeData readBake(const std::string& path, const ReadOptions& options) {
     if (!std::filesystem::exists(status)) throw inputError(path, "file not found");
     if (std::filesystem::is_directory(status))
         throw inputError(path, "is a directory, not a bake file");
+    if (!std::filesystem::is_regular_file(status))
+        throw inputError(path, "is not a regular file (a FIFO or device?), not a bake file");
 
     std::unique_ptr<Imf::MultiPartInputFile> file;
     try {
@@ -786,7 +935,7 @@ BakeData readBake(const std::string& path, const ReadOptions& options) {
         throw inputError(path, str("not an OpenEXR file: ", e.what()));
     }
     try {
-        return readParts(*file, options);
+        return readParts(*file, options, std::filesystem::file_size(path, ec));
     } catch (const InputError& e) {
         throw inputError(path, e.what());
     } catch (const Iex::BaseExc& e) {

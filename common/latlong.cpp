@@ -16,6 +16,8 @@ LatLongImage loadLatLong(const std::string& path) {
     LatLongImage img;
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) throw inputError(path, "file not found");
+    if (!std::filesystem::is_regular_file(path, ec))
+        throw inputError(path, "is not a regular file, not an environment image");
     try {
         Imf::RgbaInputFile file(path.c_str());
         // A multi-part file (a shrefract bake) opens as its first part, which has no colour:

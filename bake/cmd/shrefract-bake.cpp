@@ -11,6 +11,7 @@
 #include "bake/cmd/common_cli.h"
 #include "common/cli/cli.h"
 #include "common/error.h"
+#include "common/limits.h"
 #include "common/output.h"
 
 using namespace shrefract;
@@ -33,18 +34,18 @@ int main(int argc, char** argv) {
     std::string targetReport;
     app.add_option("input", input, "mesh (.obj .off .ply .stl) or scene (.json)")->required();
     app.add_option("-o,--output", output, "output file, NAME.shrefract.exr")->required();
-    app.add_option("--order", opt.order, "SH order L: bands 0..L")->capture_default_str()->check(CLI::Range(0, 20));
+    app.add_option("--order", opt.order, "SH order L: bands 0..L")->capture_default_str()->check(CLI::Range(0, limits::kMaxOrder));
     auto* rateOpt = app.add_option("--rate", rate, "grid steps per triangle edge (overrides --samples)")
-                        ->check(CLI::Range(1, 64));
+                        ->check(CLI::Range(1, limits::kMaxRate));
     app.add_option("--samples", samples, "target number of unique surface samples")
         ->capture_default_str()->check(CLI::Range(size_t(1), size_t(50'000'000)))->excludes(rateOpt);
     app.add_option("--grid", grid, "view directions over the hemisphere, NTHETAxNPHI")->capture_default_str();
-    app.add_option("--ior", ior, "index of refraction for a bare mesh")->capture_default_str()->check(CLI::Range(1.0, 5.0));
+    app.add_option("--ior", ior, "index of refraction for a bare mesh")->capture_default_str()->check(CLI::Range(limits::kMinIor, limits::kMaxIor));
     app.add_option("--branch", branch, "fresnel: larger Fresnel branch; transmit: refract unless TIR")
         ->capture_default_str()->check(CLI::IsMember({"fresnel", "transmit"}));
-    app.add_option("--max-bounces", opt.trace.maxBounces, "bounce cap per path")->capture_default_str()->check(CLI::Range(1, 10000));
+    app.add_option("--max-bounces", opt.trace.maxBounces, "bounce cap per path")->capture_default_str()->check(CLI::Range(1, limits::kMaxBounces));
     app.add_option("--filter", opt.filterWidth, "semi-Gaussian SH low-pass width in bands (0: none)")
-        ->capture_default_str()->check(CLI::Range(0.0, 1000.0));
+        ->capture_default_str()->check(CLI::Range(0.0, limits::kMaxFilterWidth));
     std::string fit = ToString(opt.fit), weighting = opt.weighting.ToString();
     app.add_option("--fit", fit, "projection: W = M R through the compression matrix (the paper); lsq: "
                                  "least squares on the grid samples; weighted: least squares weighted by "

@@ -114,7 +114,8 @@ struct RefractorOptions {
     // draw; needs a one-pass preset and no smoothing); "texture": decompression passes into D_mu
     // first; "auto": the measured default (docs/runtime.md).
     std::string decompression = "auto";
-    int order = -1;                 // SH order used, -1: all stored
+    int order = -1;                 // SH order used, -1: all uploaded; above maxOrder clamps
+                                    // to it (order() tells); below -1: std::invalid_argument
     int maxOrder = -1;              // bands uploaded to the GPU, 0..maxOrder (-1: all stored);
                                     // setOrder() cannot go above it
     // Float32 bakes upload as RGBA16F (half the memory). f16 bakes are always RGBA16F, u8 bakes
@@ -152,7 +153,8 @@ public:
     glm::ivec2 refractionMapSize() const;
     std::string path() const;           // "rho" or "direct"
     std::string decompression() const;  // "texture" or "vertex"
-    // Progressive decompression (paper §6): use bands 0..L, clamped to the uploaded maxOrder.
+    // Progressive decompression (paper §6): use bands 0..L, as RefractorOptions::order does:
+    // -1 is all uploaded bands, above maxOrder clamps to it, below -1 is std::invalid_argument.
     void setOrder(int L);
     int order() const;
     void setSmoothing(bool on);

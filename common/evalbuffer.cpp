@@ -11,6 +11,7 @@
 #include <ImfOutputFile.h>
 
 #include "common/error.h"
+#include "common/exr_input.h"
 #include "common/exr_output.h"
 #include "common/output.h"
 
@@ -74,6 +75,8 @@ void writeEvalBuffer(const std::string& path, const EvalBuffer& buffer) {
 
 EvalBuffer readEvalBuffer(const std::string& path) {
     EvalBuffer b;
+    if (!std::filesystem::is_regular_file(path)) throw inputError(path, "file not found");
+    checkExrHeaders(path);  // before OpenEXR allocates what a damaged header claims
     try {
         Imf::InputFile file(path.c_str());
         const Imath::Box2i dw = file.header().dataWindow();

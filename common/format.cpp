@@ -37,6 +37,7 @@
 #include "common/checksum.h"
 #include "common/direction_grid.h"
 #include "common/error.h"
+#include "common/exr_input.h"
 #include "common/exr_output.h"
 #include "common/limits.h"
 #include "common/output.h"
@@ -832,7 +833,8 @@ void writeBake(const std::string& path, const BakeData& data) {
         throw std::invalid_argument("writeBake(" + path + "): the manifest is not a JSON object");
     const SurfaceLayout& L = data.layout;
     const U8Params u8 = data.precision == Precision::U8 ? fitU8(data) : U8Params{};
-    const auto [nlWidth, nlHeight] = neighbourListSize(L.neighbourIndex.size());
+    const std::pair<int, int> nlSize = neighbourListSize(L.neighbourIndex.size());
+    const int nlWidth = nlSize.first, nlHeight = nlSize.second;  // (lambdas below capture them)
 
     // The parts' pixels are staged first: their checksums go into the manifest, which every
     // part's header carries.
@@ -928,6 +930,7 @@ BakeData readBake(const std::string& path, const ReadOptions& options) {
     if (!std::filesystem::is_regular_file(status))
         throw inputError(path, "is not a regular file (a FIFO or device?), not a bake file");
 
+    checkExrHeaders(path);  // before OpenEXR allocates what a damaged header claims
     std::unique_ptr<Imf::MultiPartInputFile> file;
     try {
         file = std::make_unique<Imf::MultiPartInputFile>(path.c_str());

@@ -9,6 +9,7 @@
 #include <ImfStringAttribute.h>
 
 #include "common/error.h"
+#include "common/exr_input.h"
 
 namespace shrefract {
 
@@ -18,6 +19,7 @@ LatLongImage loadLatLong(const std::string& path) {
     if (!std::filesystem::exists(path, ec)) throw inputError(path, "file not found");
     if (!std::filesystem::is_regular_file(path, ec))
         throw inputError(path, "is not a regular file, not an environment image");
+    checkExrHeaders(path);  // before OpenEXR allocates what a damaged header claims
     try {
         Imf::RgbaInputFile file(path.c_str());
         // A multi-part file (a shrefract bake) opens as its first part, which has no colour:

@@ -77,28 +77,27 @@ private:
 void checkOff(const std::string& path, const std::string& text) {
     Lines lines(text);
     std::string line;
-    if (!lines.next(&line)) return;
+    if (!lines.next(&line)) throw inputError(path, "could not parse: no OFF header");
     std::vector<std::string> t = tokens(line);
     const std::string key = t.empty() ? "" : t[0];
-    // [C][N][4][n]OFF: the variants with an explicit or fourth dimension are left to OpenMesh.
-    if (key.size() < 3 || key.compare(key.size() - 3, 3, "OFF") != 0) return;
-    if (key.find('4') != std::string::npos || key.find('n') != std::string::npos) return;
+    // [ST][C][N]OFF. Anything else is refused here rather than left to OpenMesh, which reads
+    // counts from whatever follows and reserves memory for them (found by the fuzzer: an "OFF&"
+    // header with a count of -1).
+    static const char* const kKeys[] = {"OFF", "COFF", "NOFF", "CNOFF", "STOFF", "STCOFF", "STNOFF",
+                                        "STCNOFF"};
+    if (std::find(std::begin(kKeys), std::end(kKeys), key) == std::end(kKeys))
+        throw inputError(path, "could not parse: '" + key + "' is not an OFF keyword this reader knows "
+                               "(OFF, COFF, NOFF, CNOFF, ST...)");
     t.erase(t.begin());
     if (!t.empty() && t[0] == "BINARY") {
         // Counts then data as 32-bit values; refuse only what neither byte order can hold.
         const size_t at = lines.offset();
         if (at == size_t(-1) || text.size() < at + 12)
             throw inputError(path, "cut short: binary OFF without its vertex and face counts");
-        uint32_t raw[2];
+        uint32_t raw[2];  // as OpenMesh reads them: in the machine's byte order
         std::memcpy(raw, text.data() + at, 8);
         const uint64_t rest = text.size() - at - 12;
-        bool fits = false;
-        for (bool swap : {false, true}) {
-            uint64_t nv = raw[0], nf = raw[1];
-            if (swap) nv = __builtin_bswap32(raw[0]), nf = __builtin_bswap32(raw[1]);
-            fits |= nv * 12 + nf * 16 <= rest;  // xyz per vertex; k and 3 indices per face
-        }
-        if (!fits)
+        if (uint64_t(raw[0]) * 12 + uint64_t(raw[1]) * 16 > rest)  // xyz; k and 3 indices
             throw inputError(path, "cut short: the binary OFF header promises more vertices and "
                                    "faces than its " + std::to_string(rest) + " bytes of data hold");
         return;
@@ -109,7 +108,7 @@ void checkOff(const std::string& path, const std::string& text) {
     }
     uint64_t nv = 0, nf = 0;
     if (t.size() < 2 || !isCount(t[0], &nv) || !isCount(t[1], &nf))
-        return;  // not OFF as we know it: OpenMesh decides
+        throw inputError(path, "could not parse: no vertex and face counts after " + key);
     const std::string promise = "the header promises " + std::to_string(nv) + " vertices and " +
                                 std::to_string(nf) + " faces";
     for (uint64_t v = 0; v < nv; ++v) {
@@ -172,6 +171,9 @@ void checkPly(const std::string& path, const std::string& text) {
     std::string format;
     std::vector<PlyElement> elements;
     bool ended = false;
+    // The header is checked line by line as the PLY format defines it: OpenMesh's reader trusts
+    // it (a property before any element crashed it, found by the fuzzer: tests/fuzz/regressions).
+    auto bad = [&](const std::string& why) { return inputError(path, "PLY header: '" + line + "' " + why); };
     while (std::getline(in, line)) {
         if (!line.empty() && line.back() == '\r') line.pop_back();
         const std::vector<std::string> t = tokens(line);
@@ -180,27 +182,36 @@ void checkPly(const std::string& path, const std::string& text) {
             ended = true;
             break;
         }
-        if (t[0] == "format" && t.size() >= 2) format = t[1];
-        if (t[0] == "element") {
+        if (t[0] == "comment" || t[0] == "obj_info") continue;
+        if (t[0] == "format") {
+            if (t.size() != 3 || !format.empty() ||
+                (t[1] != "ascii" && t[1] != "binary_little_endian" && t[1] != "binary_big_endian"))
+                throw bad("is not a format this reader knows");
+            format = t[1];
+        } else if (t[0] == "element") {
             PlyElement e;
-            if (t.size() < 3 || !isCount(t[2], &e.count))
-                throw inputError(path, "PLY header: '" + line + "' has no count");
+            if (t.size() != 3 || !isCount(t[2], &e.count) || e.count > (uint64_t(1) << 31))
+                throw bad("is not 'element NAME COUNT'");
             e.name = t[1];
             elements.push_back(e);
-        }
-        if (t[0] == "property" && !elements.empty()) {
+        } else if (t[0] == "property") {
+            if (elements.empty()) throw bad("comes before any element");
             PlyProperty p;
-            if (t.size() >= 5 && t[1] == "list") {
+            if (t.size() == 5 && t[1] == "list") {
                 p.countSize = plyTypeSize(t[2]);
                 p.size = plyTypeSize(t[3]);
-            } else if (t.size() >= 3) {
+                if (t[2].find("float") != std::string::npos || t[2] == "double") p.countSize = 0;
+            } else if (t.size() == 3) {
                 p.size = plyTypeSize(t[1]);
             }
             if (p.size == 0 || (t[1] == "list" && p.countSize == 0))
-                throw inputError(path, "PLY header: unknown property type in '" + line + "'");
+                throw bad("is not a property of a known type");
             elements.back().properties.push_back(p);
+        } else {
+            throw bad("is not a PLY header line");
         }
     }
+    if (format.empty()) throw inputError(path, "PLY header without a format line");
     if (!ended) throw inputError(path, "cut short: the PLY header has no end_header");
     auto promise = [&](const PlyElement& e, uint64_t got) {
         return "cut short: the header promises " + std::to_string(e.count) + " " + e.name +

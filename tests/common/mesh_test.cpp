@@ -329,7 +329,7 @@ TEST(Mesh, UnsupportedExtension) {
 
 TEST(Mesh, GarbageIsUnparsable) {
     expectInputError(writeText("junk.off", "hello \x01\x02 world\n"),
-                     "could not parse (OpenMesh read failed)");
+                     "could not parse: 'hello' is not an OFF keyword");
     expectInputError(writeText("junk.ply", "hello \x01\x02 world\n"), "could not parse");
 }
 

@@ -11,7 +11,6 @@
 #include <sstream>
 
 #include "common/error.h"
-#include "common/limits.h"
 
 namespace shrefract {
 
@@ -36,12 +35,6 @@ bool endsWithJson(const std::string& path) {
     std::transform(ext.begin(), ext.end(), ext.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     return ext == ".json";
-}
-
-std::string numberString(double x) {
-    std::ostringstream os;
-    os << x;
-    return os.str();
 }
 
 // nlohmann::json stores non-finite doubles as numbers when built in code but never parses
@@ -172,18 +165,6 @@ Scene loadJsonScene(const std::string& path, const Medium& defaultMedium) {
 }
 
 }  // namespace
-
-std::string mediumProblem(const Medium& m) {
-    if (!std::isfinite(m.ior) || m.ior < limits::kMinIor || m.ior > limits::kMaxIor)
-        return "'ior' " + numberString(m.ior) + " is not in [" + numberString(limits::kMinIor) + ", " +
-               numberString(limits::kMaxIor) + "]";
-    for (int c = 0; c < 3; ++c) {
-        if (!std::isfinite(m.absorption[c]) || m.absorption[c] < 0.0)
-            return "'absorption' has " + numberString(m.absorption[c]) +
-                   ": each of the 3 values must be finite and >= 0";
-    }
-    return {};
-}
 
 Scene loadScene(const std::string& path, const Medium& defaultMedium) {
     if (endsWithJson(path)) return loadJsonScene(path, defaultMedium);

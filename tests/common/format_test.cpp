@@ -519,6 +519,9 @@ TEST(Format, ManifestValuesAreValidatedLikeTheBakeOptions) {
         {[](json& m) { m["rate"] = 65; }, "rate 65 is not in [1, 64]"},
         {[](json& m) { m["sampleCount"] = 4294967296ll; }, "manifest has no integer \"sampleCount\""},
         {[](json& m) { m["mu"] = {40000, 1}; }, "above 32768"},
+        // The list would be read past its part's pixels.
+        {[](json& m) { m["neighbourListLength"] = 101; },
+         "neighbour list of 101 entries does not fit its 10 x 10 part"},
     };
     int n = 0;
     for (const auto& [edit, what] : cases) {

@@ -69,9 +69,12 @@ protected:
             GTEST_SKIP() << "no " << ToString(GetParam()) << " context: " << e.what();
         }
     }
-    EvalBuffer renderSh(const Baked& b, const Environment& env, const Camera& c) {
+    EvalBuffer renderSh(const Baked& b, const Environment& env, const Camera& c,
+                        const std::string& path = "auto", const std::string& shading = "spread") {
         RefractorOptions o;
         o.loader = context_->loader();
+        o.path = path;
+        o.shading = shading;
         auto refractor = Refractor::create(makeBake(b.data), o);
         RenderedFrame f = renderFrame(*refractor, env, c, kSize, kSize);
         return makeEvalBuffer(kSize, kSize, f.color, f.directions);
@@ -96,10 +99,11 @@ double stat(const nlohmann::json& r, const char* key) { return r["angleDeg"][key
 // The icosphere (1280 triangles, rate 1 = its 642 vertices, order 8, 32x64 grid), 128x128, three
 // views. Measured on llvmpipe (EGL and OSMesa give identical buffers): median 1.21-1.30 deg,
 // p95 8.2-11.3 deg (silhouette pixels, where the SH ring), coverage mismatch <= 2 pixels of
-// ~4990; tone-mapped PSNR 23.57, 25.01, 26.35 dB and SSIM 0.896, 0.905, 0.902 in the three views.
-// Thresholds: median 2 deg, p95 14 deg, mismatch 1% of the covered pixels; PSNR 1 dB and SSIM
-// 0.02 below each view's measurement (the image is what a user sees: a wrong Fresnel, absorption
-// or tone map in the shading moves them by more).
+// ~4990. With the paper's sharp lookup (the reference's, one sample per pixel), tone-mapped PSNR
+// 23.57, 25.01, 26.35 dB and SSIM 0.896, 0.905, 0.902 in the three views. Thresholds: median 2
+// deg, p95 14 deg, mismatch 1% of the covered pixels; PSNR 1 dB and SSIM 0.02 below each view's
+// measurement (the image is what a user sees: a wrong Fresnel, absorption or tone map in the
+// shading moves them by more).
 TEST_P(EndToEnd, ShMatchesTheRaytracedReferenceOnTheIcosphere) {
     const Baked& b = baked("icosphere.off", 1);
     const LatLongImage& img = environment().latLong;
@@ -108,7 +112,7 @@ TEST_P(EndToEnd, ShMatchesTheRaytracedReferenceOnTheIcosphere) {
     int n = 0;
     for (glm::vec3 view : {glm::vec3(30, 20, 4), glm::vec3(150, -10, 4), glm::vec3(270, 60, 4)}) {
         const Camera c = camera(view.x, view.y, view.z);
-        nlohmann::json r = compareImages(reference(b, c), renderSh(b, env, c));
+        nlohmann::json r = compareImages(reference(b, c), renderSh(b, env, c, "auto", "sharp"));
         std::printf("  view %g,%g: median %.3f p95 %.3f mean %.3f deg, mismatch %zu of %zu, PSNR %.2f, SSIM %.4f\n",
                     view.x, view.y, stat(r, "median"), stat(r, "p95"), stat(r, "mean"),
                     r["coverage"]["mismatch"].get<size_t>(), r["coverage"]["ref"].get<size_t>(),
@@ -176,8 +180,9 @@ TEST_P(EndToEnd, ShBeatsSingleAndWymanOnTheBeadInTheShell) {
 }
 
 // The runtime's per-pixel exit direction equals what `shrefract-eval query` answers at the same
-// surface point and view direction: the rho layout's interpolation, UVs and correction texels on
-// the GPU against the CPU's interpolateRho, triangle by triangle. Each covered pixel's centre is
+// surface point and view direction, on both interpolation paths: the rho layout's interpolation,
+// UVs and correction texels (and the direct path's refined mesh) on the GPU against the CPU's
+// interpolateRho, triangle by triangle. Each covered pixel's centre is
 // ray-cast onto the bake's triangles (the mesh the runtime draws); the viewer is far (distance 60,
 // 3 degree field of view), so that one view direction serves a whole triangle as query assumes
 // (parallax < 0.1 deg). Pixels on a silhouette (a neighbour uncovered) are left out. Measured on
@@ -188,10 +193,11 @@ TEST_P(EndToEnd, GpuDirectionsMatchQueryAtTheSameSurfacePoints) {
     const SurfaceLayout& L = b.data.layout;
     const LatLongImage& img = environment().latLong;
     Environment env = Environment::fromLatLong(img.width, img.height, img.rgb);
+    for (const char* path : {"rho", "direct"})
     for (glm::vec2 view : {glm::vec2(30, 20), glm::vec2(200, -40)}) {
         Camera c = camera(view.x, view.y, 60);
         c.fovDegrees = 3;
-        const EvalBuffer gl = renderSh(b, env, c);
+        const EvalBuffer gl = renderSh(b, env, c, path);
         const glm::mat4 inverse = glm::inverse(projectionMatrix(c, kSize, kSize) * viewMatrix(c));
         std::vector<glm::vec3> points, omegas;
         std::vector<size_t> pixels;
@@ -232,8 +238,8 @@ TEST_P(EndToEnd, GpuDirectionsMatchQueryAtTheSameSurfacePoints) {
             errors.push_back(std::acos(std::clamp(cosA, -1.0f, 1.0f)) * 180 / 3.14159265);
         }
         const nlohmann::json e = errorStats(errors);
-        std::printf("  view %g,%g: GPU vs query over %zu pixels: median %.4f p99 %.4f max %.3f deg\n",
-                    view.x, view.y, errors.size(), e["median"].get<double>(), e["p99"].get<double>(),
+        std::printf("  %s path, view %g,%g: GPU vs query over %zu pixels: median %.4f p99 %.4f max %.3f deg\n",
+                    path, view.x, view.y, errors.size(), e["median"].get<double>(), e["p99"].get<double>(),
                     e["max"].get<double>());
         EXPECT_LT(e["median"].get<double>(), 0.05);
         EXPECT_LT(e["p99"].get<double>(), 0.25);

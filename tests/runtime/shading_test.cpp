@@ -25,8 +25,8 @@ constexpr int kColumns = 16;
 // ground, so that the colour is the Fresnel reflectance F. Row 1 tone maps (x, x/3, 3x) for
 // x = 2^(i/2 - 5). Row 2 looks straight down the normal with both rays in the sky, through a path
 // of length i / 10 absorbing (0.5, 1, 2) per unit: F(0) + (1 - F(0)) exp(-kappa length).
+// Sharp lookups (lobe widths 0) throughout.
 const char* kMain = R"(
-uniform samplerCube uEnvironment;
 uniform float uEta;
 layout(location = 0) out vec4 oColor;
 void main() {
@@ -34,10 +34,10 @@ void main() {
     if (gl_FragCoord.y < 1.0) {
         float theta = radians(75.0 * i / 15.0);
         vec3 n = vec3(0.0, 1.0, 0.0), v = vec3(sin(theta), cos(theta), 0.0);
-        oColor = vec4(shadeGlass(uEnvironment, vec3(0.0, -1.0, 0.0), 0.0, n, v, uEta, vec3(0.0)), 1.0);
+        oColor = vec4(shadeGlass(vec3(0.0, -1.0, 0.0), 0.0, 0.0, n, v, uEta, vec3(0.0), 0.0), 1.0);
     } else if (gl_FragCoord.y > 2.0) {
         vec3 n = vec3(0.0, 1.0, 0.0);
-        oColor = vec4(shadeGlass(uEnvironment, n, i / 10.0, n, n, uEta, vec3(0.5, 1.0, 2.0)), 1.0);
+        oColor = vec4(shadeGlass(n, 0.0, i / 10.0, n, n, uEta, vec3(0.5, 1.0, 2.0), 0.0), 1.0);
     } else {
         float x = exp2(i / 2.0 - 5.0);
         oColor = vec4(toneMap(vec3(x, x / 3.0, 3.0 * x), 1.0), 1.0);
@@ -93,6 +93,8 @@ TEST_P(ShadingGlsl, FresnelAbsorptionAndToneMapMatchTheirClosedForms) {
     glDisable(GL_DEPTH_TEST);
     glUseProgram(program);
     glUniform1i(glGetUniformLocation(program, "uEnvironment"), 0);
+    glUniform1f(glGetUniformLocation(program, "uEnvironmentFaceSize"), float(env.faceSize()));
+    glUniform1f(glGetUniformLocation(program, "uEnvironmentLevels"), float(env.levels()));
     glUniform1f(glGetUniformLocation(program, "uEta"), 1.5f);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_CUBE_MAP, env.cubeMap());

@@ -319,18 +319,48 @@ void checkStl(const std::string& path, const std::string& text) {
 
 // --- OBJ ----------------------------------------------------------------------------------------
 
+// A face corner: v, v/t, v//n or v/t/n, each a non-zero integer (negative: relative).
+bool isObjCorner(const std::string& t) {
+    size_t at = 0;
+    for (int field = 0; field < 3; ++field) {
+        const size_t start = at;
+        if (at < t.size() && t[at] == '-') ++at;
+        const size_t digits = at;
+        while (at < t.size() && std::isdigit(static_cast<unsigned char>(t[at]))) ++at;
+        if (at == digits) {
+            if (field == 0 || at != start) return false;  // the vertex index is required
+        } else if (t.find_first_not_of('0', digits) >= at) {
+            return false;  // index 0 does not exist in OBJ
+        }
+        if (at == t.size()) return true;
+        if (t[at] != '/' || field == 2) return false;
+        ++at;
+    }
+    return false;
+}
+
 void checkObj(const std::string& path, const std::string& text) {
     std::istringstream in(text);
     std::string line;
     size_t number = 0;
+    auto bad = [&](const std::string& what) {
+        return inputError(path, "line " + std::to_string(number) + ": " + what);
+    };
     while (std::getline(in, line)) {
         ++number;
         const std::vector<std::string> t = tokens(line);
         if (t.empty()) continue;
-        if (t[0] == "v" && (t.size() < 4 || !isNumber(t[1]) || !isNumber(t[2]) || !isNumber(t[3])))
-            throw inputError(path, "line " + std::to_string(number) + ": a vertex of fewer than 3 numbers");
-        if (t[0] == "f" && t.size() < 4)
-            throw inputError(path, "line " + std::to_string(number) + ": a face of fewer than 3 corners");
+        // OpenMesh's OBJ reader asserts on a face without a readable corner (found by the
+        // fuzzer), so vertex and face lines are checked to the letter.
+        if (t[0] == "v") {
+            const size_t n = t.size() - 1;
+            if ((n != 3 && n != 4 && n != 6 && n != 7) || !std::all_of(t.begin() + 1, t.end(), isNumber))
+                throw bad("a vertex is not 3 numbers (or 4, or with 3 colour values)");
+        } else if (t[0] == "f") {
+            if (t.size() < 4) throw bad("a face of fewer than 3 corners");
+            if (!std::all_of(t.begin() + 1, t.end(), isObjCorner))
+                throw bad("a face corner is not v, v/t, v//n or v/t/n with non-zero indices");
+        }
     }
 }
 

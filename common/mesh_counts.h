@@ -14,7 +14,8 @@ namespace shrefract {
 //   PLY   every element's count of lines (ascii) or of records (binary, lists walked);
 //   STL   binary: exactly 84 + 50 n bytes for its n triangles; ASCII: 3 vertices per facet,
 //         every facet closed, "endsolid" at the end;
-//   OBJ   (no header) every "v" line has 3 numbers and every "f" line 3 or more corners.
+//   OBJ   (no header) every "v" line is 3 numbers (or 4, or with 3 colour values) and every "f"
+//         line 3 or more corners v, v/t, v//n or v/t/n with non-zero integer indices.
 // `ext` is the lower-case extension with its dot. Files it cannot classify are left to OpenMesh.
 void checkMeshCounts(const std::string& path, const std::string& ext);
 

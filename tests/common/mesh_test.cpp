@@ -308,7 +308,9 @@ TEST(Mesh, CutShortFilesAreRefused) {
     expectInputError(writeText("short.ply", ply.substr(0, ply.size() - 13)),
                      "cut short: the header promises 12 face elements, the file ends after 11");
     expectInputError(writeText("short.obj", "v 0 0 0\nv 1 0 0\nv 0 1\n"),
-                     "line 3: a vertex of fewer than 3 numbers");
+                     "line 3: a vertex is not 3 numbers");
+    expectInputError(writeText("corner.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 f 3\n"),
+                     "line 4: a face corner is not v, v/t, v//n or v/t/n");
 }
 
 TEST(Mesh, InwardWoundClosedMeshIsFlipped) {

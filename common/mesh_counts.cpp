@@ -184,7 +184,7 @@ void checkPly(const std::string& path, const std::string& text) {
         }
         if (t[0] == "comment" || t[0] == "obj_info") continue;
         if (t[0] == "format") {
-            if (t.size() != 3 || !format.empty() ||
+            if (t.size() != 3 || !format.empty() || t[2] != "1.0" ||
                 (t[1] != "ascii" && t[1] != "binary_little_endian" && t[1] != "binary_big_endian"))
                 throw bad("is not a format this reader knows");
             format = t[1];

@@ -10,7 +10,10 @@ namespace shrefract {
 
 // Throws InputError naming `path` ("truncated or corrupt: ...") unless the file starts with
 // OpenEXR's magic number and every header attribute (of every part) fits in the file, with names
-// no longer than OpenEXR allows and at most 1024 parts of 4096 attributes.
+// no longer than OpenEXR allows and at most 1024 parts of 4096 attributes. OpenEXR's typed readers
+// read what their type holds, not what the size field says (a channel list up to its empty name),
+// so every value must fill its size exactly the way OpenEXR reads it, or OpenEXR would read the
+// rest of the header out of step and take whatever bytes it lands on for a size.
 void checkExrHeaders(const std::string& path);
 
 }  // namespace shrefract

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -111,14 +112,23 @@ void checkOff(const std::string& path, const std::string& text) {
         throw inputError(path, "could not parse: no vertex and face counts after " + key);
     const std::string promise = "the header promises " + std::to_string(nv) + " vertices and " +
                                 std::to_string(nf) + " faces";
+    // Every value as OpenMesh's stream reads it: a number it would overflow on (and then read no
+    // further, for ever: found by the fuzzer) is refused here.
+    auto number = [](const std::string& x, double limit) {
+        if (!isNumber(x)) return false;
+        const double v = std::strtod(x.c_str(), nullptr);
+        return !(std::fabs(v) > limit);  // NaN passes: the non-finite scan names it
+    };
     for (uint64_t v = 0; v < nv; ++v) {
         if (!lines.next(&line))
             throw inputError(path, "cut short: " + promise + ", the file ends after " +
                                        std::to_string(v) + " vertices");
         t = tokens(line);
-        if (t.size() < 3 || !isNumber(t[0]) || !isNumber(t[1]) || !isNumber(t[2]))
+        if (t.size() < 3 || t.size() > 12 ||
+            !std::all_of(t.begin(), t.end(), [&](const std::string& x) { return number(x, 1e30); }))
             throw inputError(path, "line " + std::to_string(lines.number()) + ": vertex " +
-                                       std::to_string(v) + " is not 3 numbers");
+                                       std::to_string(v) + " is not 3 numbers (and its normal, "
+                                       "colour or texture coordinates)");
     }
     for (uint64_t f = 0; f < nf; ++f) {
         if (!lines.next(&line))
@@ -126,11 +136,21 @@ void checkOff(const std::string& path, const std::string& text) {
                                        std::to_string(f) + " faces");
         t = tokens(line);
         uint64_t k = 0;
-        if (t.empty() || !isCount(t[0], &k) || t.size() < k + 1 ||
-            !std::all_of(t.begin() + 1, t.begin() + 1 + long(k),
-                         [](const std::string& x) { uint64_t i; return isCount(x, &i); }))
-            throw inputError(path, "line " + std::to_string(lines.number()) + ": face " +
-                                       std::to_string(f) + " is not a count and that many indices");
+        const std::string where = "line " + std::to_string(lines.number()) + ": face " + std::to_string(f);
+        if (t.empty() || !isCount(t[0], &k) || t.size() < k + 1)
+            throw inputError(path, where + " is not a count and that many indices");
+        for (uint64_t c = 1; c <= k; ++c) {
+            uint64_t index = 0;
+            if (!isCount(t[c], &index) || index >= nv)
+                throw inputError(path, where + " refers to vertex " + t[c] + " of " +
+                                           std::to_string(nv));
+        }
+        // An optional colour: 3 or 4 values after the indices.
+        const size_t extra = t.size() - 1 - k;
+        if ((extra != 0 && extra != 3 && extra != 4) ||
+            !std::all_of(t.begin() + 1 + long(k), t.end(), [&](const std::string& x) { return number(x, 65535); }))
+            throw inputError(path, where + " has " + std::to_string(extra) +
+                                       " values after its indices, not a colour");
     }
 }
 

@@ -348,7 +348,7 @@ TEST(Mesh, NoFaces) {
 
 TEST(Mesh, FaceIndexOutOfRangeIsUnparsable) {
     expectInputError(writeText("bad.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n"),
-                     "could not parse: 1 faces refer to vertices that do not exist");
+                     "line 6: face 0 refers to vertex 7 of 3");
 }
 
 TEST(Mesh, NanCoordinateInTextOff) {

@@ -17,6 +17,8 @@
 #include "bake/tracer.h"
 #include "common/bakefile.h"
 #include "common/direction_grid.h"
+#include "common/error.h"
+#include "common/error.h"
 #include "common/scene.h"
 
 namespace shrefract {
@@ -134,10 +136,6 @@ private:
 struct BakeResult {
     BakeData data;
     BakeStats stats;
-};
-
-struct Cancelled : std::runtime_error {
-    Cancelled() : std::runtime_error("cancelled") {}
 };
 
 // The whole bake in one slice. `inputPath` is recorded in the manifest so evaluation can

@@ -318,7 +318,7 @@ BakeResult bakeWithCheckpoints(const BakePlan& plan, const CheckpointOptions& op
     for (const auto& e : fs::directory_iterator(dir)) {
         const std::string name = e.path().filename().string();
         std::smatch m;
-        if (name.find(".tmp.") != std::string::npos) {
+        if (name.find(".shrefract-tmp.") != std::string::npos) {
             fs::remove(e.path(), ec);
         } else if (std::regex_match(name, m, kCheckpointName) && std::stoi(m[2]) != N) {
             foreign.push_back(e.path().string());
@@ -381,22 +381,6 @@ void removeCheckpoints(const std::string& workDir) {
     }
     fs::remove(fs::path(workDir) / "lock", ec);
     fs::remove(workDir, ec);  // only if empty: anything else the user put there stays
-}
-
-int removeStaleTemporaries(const std::string& path) {
-    const fs::path p = fs::absolute(path);
-    const std::string prefix = p.filename().string() + ".tmp.";
-    int removed = 0;
-    std::error_code ec;
-    for (const auto& e : fs::directory_iterator(p.parent_path(), ec)) {
-        const std::string name = e.path().filename().string();
-        if (name.rfind(prefix, 0) != 0) continue;
-        const std::string pid = name.substr(prefix.size());
-        if (pid.empty() || pid.find_first_not_of("0123456789") != std::string::npos) continue;
-        if (::kill(pid_t(std::stol(pid)), 0) == 0 || errno != ESRCH) continue;  // still running
-        if (fs::remove(e.path(), ec)) ++removed;
-    }
-    return removed;
 }
 
 }  // namespace shrefract

@@ -77,8 +77,5 @@ BakeResult bakeWithCheckpoints(const BakePlan& plan, const CheckpointOptions& op
 // Removes the work folder's checkpoints, and the folder (once the bake file is safely written).
 void removeCheckpoints(const std::string& workDir);
 
-// Removes PATH.tmp.PID files that a killed writer left beside `path` (their process is gone).
-// Returns how many.
-int removeStaleTemporaries(const std::string& path);
 
 }  // namespace shrefract

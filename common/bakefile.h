@@ -85,8 +85,10 @@ struct ReadOptions {
     bool verify = true;
 };
 
-// Writes to a temporary name beside `path` and renames it when complete: on any failure nothing
-// is left and an existing file at `path` is untouched. Quantizes to `data.precision`.
+// Writes to a temporary file beside `path` and renames it when complete (writeAtomically,
+// common/output.h): on any failure nothing is left and an existing file at `path` is untouched;
+// a refused target (missing folder, symbolic link, FIFO, device) is an InputError, a failed
+// write an IoError with the OS's reason. Quantizes to `data.precision`.
 void writeBake(const std::string& path, const BakeData& data);
 // Reads and validates; throws InputError naming the file and the problem (missing, not a
 // shrefract bake, newer format version than kFormatVersion, a part or the manifest that does not

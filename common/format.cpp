@@ -17,11 +17,8 @@
 #include <ImfMultiPartOutputFile.h>
 #include <ImfOutputPart.h>
 #include <ImfPartType.h>
-#include <ImfStdIO.h>
 #include <ImfStringAttribute.h>
-#include <fcntl.h>
 #include <half.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -38,7 +35,13 @@
 
 #include "common/bakefile.h"
 #include "common/checksum.h"
+#include "common/direction_grid.h"
 #include "common/error.h"
+#include "common/exr_input.h"
+#include "common/exr_output.h"
+#include "common/limits.h"
+#include "common/output.h"
+#include "common/scene.h"
 #include "common/sh.h"
 
 namespace shrefract {
@@ -175,6 +178,10 @@ std::vector<Channel> weightChannels(int K, Precision p) {
     }
     return ch;
 }
+// Bytes of one weights texel: 16 per coefficient in f32, 8 in f16, 4 in u8.
+uint64_t weightsTexelBytes(int K, Precision p) {
+    return uint64_t(K) * (p == Precision::U8 ? 4 : p == Precision::F16 ? 8 : 16);
+}
 const std::vector<Channel> kSampleChannels = {
     {"P.x", Imf::FLOAT}, {"P.y", Imf::FLOAT}, {"P.z", Imf::FLOAT}, {"N.x", Imf::FLOAT},
     {"N.y", Imf::FLOAT}, {"N.z", Imf::FLOAT}, {"part", Imf::UINT}};
@@ -258,7 +265,8 @@ std::string str(const T&... parts) {
 
 std::string inconsistency(const BakeData& d) {
     const SurfaceLayout& L = d.layout;
-    if (d.order < 0) return str("order ", d.order, " is negative");
+    if (d.order < 0 || d.order > limits::kMaxOrder)
+        return str("SH order ", d.order, " is not in [0, ", limits::kMaxOrder, "]");
     const size_t K = size_t(d.coefficientCount());
     const size_t N = L.position.size();
     if (L.normal.size() != N || L.part.size() != N)
@@ -272,7 +280,11 @@ std::string inconsistency(const BakeData& d) {
         return str("rho layout is ", L.rhoWidth, " x ", L.rhoHeight, " texels");
     if (L.rho.size() != size_t(L.rhoWidth) * size_t(L.rhoHeight))
         return str("rho has ", L.rho.size(), " texels, expected ", L.rhoWidth, " x ", L.rhoHeight);
-    if (L.rate < 1) return str("rate ", L.rate, " is below 1");
+    if (L.rate < 1 || L.rate > limits::kMaxRate)
+        return str("rate ", L.rate, " is not in [1, ", limits::kMaxRate, "]");
+    for (int side : {L.muWidth, L.muHeight, L.rhoWidth, L.rhoHeight})
+        if (side > limits::kMaxTextureSize)
+            return str("a layout side of ", side, " texels is above ", limits::kMaxTextureSize);
     if (L.triangleCount < 0) return str("triangle count ", L.triangleCount, " is negative");
     if (L.triangleCount > 0) {
         if (L.blockWidth < 1 || L.blockHeight < 1 || L.blocksPerRow < 1)
@@ -285,6 +297,13 @@ std::string inconsistency(const BakeData& d) {
             return str(L.triangleCount, " triangles in ", L.blockWidth, " x ", L.blockHeight,
                        " blocks, ", L.blocksPerRow, " per row, do not fit the ", L.rhoWidth, " x ",
                        L.rhoHeight, " rho layout");
+        // A block holds an upright triangle's samples (i + j <= r) and corrections (r + 1), and
+        // its rotated partner's, without the two meeting (docs/format.md "rho").
+        const int r = L.rate;
+        if (L.blockWidth < r + 1 || L.blockHeight < r + 1 || L.blockWidth + L.blockHeight < 2 * r + 5)
+            return str("rho blocks of ", L.blockWidth, " x ", L.blockHeight,
+                       " texels cannot hold two triangles at rate ", r);
+        if (N == 0) return str(L.triangleCount, " triangles but no samples");
     }
     for (size_t t = 0; t < L.rho.size(); ++t) {
         const RhoTexel& r = L.rho[t];
@@ -296,6 +315,29 @@ std::string inconsistency(const BakeData& d) {
         if (bad)
             return str("rho texel (", x, ", ", y, ") refers to samples (", r.a, ", ", r.b, ", ",
                        r.c, ") but there are only ", N);
+    }
+    // Every triangle's grid positions hold its samples, and the texels past its hypotenuse its
+    // corrections: what the runtime and queryBake look up (SurfaceLayout::sampleAt).
+    for (int t = 0; t < L.triangleCount; ++t) {
+        for (int j = 0; j <= L.rate + 1; ++j)
+            for (int i = 0; i + j <= L.rate + 1; ++i) {
+                const bool correction = i + j == L.rate + 1;
+                if (correction && (i == 0 || j == 0)) continue;
+                const glm::ivec2 x = L.rhoTexel(t, i, j);
+                const uint32_t kind = L.rho[size_t(x.y) * size_t(L.rhoWidth) + size_t(x.x)].kind;
+                if (kind != (correction ? RhoTexel::Correction : RhoTexel::Sample))
+                    return str("triangle ", t, "'s ", correction ? "correction" : "sample",
+                               " texel (", i, ", ", j, ") at rho (", x.x, ", ", x.y,
+                               ") has kind ", kind);
+            }
+    }
+    for (size_t i = 0; i < N; ++i) {
+        const glm::vec3 p = L.position[i], n = L.normal[i];
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+            return str("sample ", i, " has a non-finite position");
+        const float len = glm::length(n);
+        if (!(std::fabs(len - 1.0f) < 1e-3f))
+            return str("sample ", i, " has a normal of length ", len, ", not a unit vector");
     }
     if (L.neighbourOffset.size() != N || L.neighbourCount.size() != N)
         return str("neighbour offsets (", L.neighbourOffset.size(), ") and counts (",
@@ -312,10 +354,27 @@ std::string inconsistency(const BakeData& d) {
         if (L.neighbourIndex[e] >= N)
             return str("neighbour list entry ", e, " refers to sample ", L.neighbourIndex[e],
                        " but there are only ", N);
+        if (!std::isfinite(L.neighbourWeight[e]))
+            return str("neighbour list entry ", e, " has a non-finite weight");
+    }
+    // Smoothing averages a sample with its neighbours: itself first, weights summing to 1.
+    for (size_t i = 0; i < N; ++i) {
+        if (L.neighbourCount[i] == 0) continue;
+        if (L.neighbourIndex[L.neighbourOffset[i]] != i)
+            return str("the neighbour list of sample ", i, " does not start with the sample itself");
+        double sum = 0;
+        for (uint32_t k = 0; k < L.neighbourCount[i]; ++k)
+            sum += L.neighbourWeight[L.neighbourOffset[i] + k];
+        if (!(std::fabs(sum - 1.0) < 1e-3))
+            return str("the neighbour weights of sample ", i, " sum to ", sum, ", not 1");
     }
     if (d.weights.size() != K * N * 4)
         return str(d.weights.size(), " weights, expected ", K, " coefficients x ", N,
                    " samples x 4");
+    for (size_t v = 0; v < d.weights.size(); ++v)
+        if (!std::isfinite(d.weights[v]))
+            return str("weight ", v / (4 * N), " of sample ", (v / 4) % N, " channel ",
+                       kWeightSuffix[v % 4], " is not finite");
     return "";
 }
 
@@ -421,52 +480,18 @@ void writeWeights(Imf::MultiPartOutputFile& file, int part, const WeightsPart& d
     }
 }
 
-// Flushes a file's data (or a folder's entries) to disk.
-void syncPath(const std::string& path) {
-    const int fd = ::open(path.c_str(), O_RDONLY);
-    if (fd < 0) return;
-    ::fsync(fd);
-    ::close(fd);
-}
-
-// Writes `path` all or nothing: `write(stream, tmpName)` fills PATH.tmp.PID in the same folder,
-// which is flushed to disk, renamed onto `path`, and the folder's entry flushed too (a power cut
-// then leaves the old file or the new one, never a part). Any failure removes the temporary and
-// leaves an existing file at `path` as it was; I/O failures are InputErrors naming `path`.
-template <class Write>
-void writeAtomically(const std::string& path, Write&& write) {
-    const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-    try {
-        std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
-        if (!os) throw inputError(path, str("cannot create ", tmp, ": ", std::strerror(errno)));
-        {
-            Imf::StdOFStream stream(os, tmp.c_str());
-            write(stream);
-        }  // the file's destructor writes the chunk offset tables; it swallows errors, the stream not
-        os.flush();
-        os.close();
-        if (os.fail())
-            throw inputError(path, str("cannot write ", tmp, ": ", std::strerror(errno)));
-        syncPath(tmp);
-        if (std::rename(tmp.c_str(), path.c_str()) != 0)
-            throw inputError(path, str("cannot rename ", tmp, " to it: ", std::strerror(errno)));
-        const std::filesystem::path folder = std::filesystem::absolute(path).parent_path();
-        syncPath(folder.string());
-    } catch (const Iex::BaseExc& e) {
-        std::remove(tmp.c_str());
-        throw inputError(path, str("cannot write: ", e.what()));
-    } catch (...) {
-        std::remove(tmp.c_str());
-        throw;
-    }
-}
-
 // ---------------------------------------------------------------------------------------------
 // Reading.
 
+bool fitsInt(const json& x) {
+    if (!x.is_number_integer()) return false;
+    if (x.is_number_unsigned()) return x.get<uint64_t>() <= uint64_t(INT32_MAX);
+    return x.get<int64_t>() >= INT32_MIN && x.get<int64_t>() <= INT32_MAX;
+}
+
 int manifestInt(const json& m, const char* key) {
     auto it = m.find(key);
-    if (it == m.end() || !it->is_number_integer())
+    if (it == m.end() || !fitsInt(*it))
         throw InputError(str("manifest has no integer \"", key, "\""));
     return it->get<int>();
 }
@@ -477,7 +502,7 @@ std::vector<int> manifestInts(const json& m, const char* key, size_t n) {
         throw InputError(str("manifest has no \"", key, "\" array of ", n, " integers"));
     std::vector<int> v;
     for (const json& x : *it) {
-        if (!x.is_number_integer())
+        if (!fitsInt(x))
             throw InputError(str("manifest has no \"", key, "\" array of ", n, " integers"));
         v.push_back(x.get<int>());
     }
@@ -494,6 +519,65 @@ std::vector<double> manifestNumbers(const json& m, const char* key, size_t n) {
         v.push_back(x.get<double>());
     }
     return v;
+}
+
+// The descriptive keys that tools act on (evaluation re-traces with the media, grid, branch and
+// bounce cap; the runtime shades with media[0]), checked as shrefract-bake checks its options and
+// a scene its media (common/limits.h, mediumProblem): a manifest that says IOR 0 is refused, not
+// rendered as a mirror. Keys a bake may lack are checked only when present. Returns what is
+// wrong, or "".
+std::string manifestProblem(const json& m) {
+    if (auto it = m.find("media"); it != m.end()) {
+        if (!it->is_array()) return "\"media\" is not an array";
+        for (size_t i = 0; i < it->size(); ++i) {
+            const json& md = (*it)[i];
+            const std::string where = str("media[", i, "]");
+            if (!md.is_object()) return where + " is not an object";
+            Medium medium;
+            if (md.contains("ior")) {
+                if (!md["ior"].is_number()) return where + ": 'ior' is not a number";
+                medium.ior = md["ior"].get<double>();
+            }
+            if (md.contains("absorption")) {
+                const json& a = md["absorption"];
+                if (!a.is_array() || a.size() != 3) return where + ": 'absorption' is not 3 numbers";
+                for (int c = 0; c < 3; ++c) {
+                    if (!a[c].is_number()) return where + ": 'absorption' is not 3 numbers";
+                    medium.absorption[c] = a[c].get<double>();
+                }
+            }
+            if (md.contains("priority") && !md["priority"].is_number_integer())
+                return where + ": 'priority' is not an integer";
+            for (const char* key : {"name", "mesh", "meshChecksum"})
+                if (md.contains(key) && !md[key].is_string())
+                    return str(where, ": '", key, "' is not a string");
+            const std::string problem = mediumProblem(medium);
+            if (!problem.empty()) return where + ": " + problem;
+        }
+    }
+    if (auto it = m.find("grid"); it != m.end() && it->is_array()) {
+        if (it->size() != 2 || !(*it)[0].is_number_integer() || !(*it)[1].is_number_integer())
+            return "\"grid\" is not [nTheta, nPhi]";
+        const std::string problem = gridProblem((*it)[0].get<int>(), (*it)[1].get<int>());
+        if (!problem.empty()) return "\"grid\": " + problem;
+    }
+    if (auto it = m.find("filterWidth"); it != m.end()) {
+        if (!it->is_number() || !(it->get<double>() >= 0.0) ||
+            it->get<double>() > limits::kMaxFilterWidth)
+            return str("\"filterWidth\" ", it->dump(), " is not in [0, ", limits::kMaxFilterWidth, "]");
+    }
+    if (auto it = m.find("maxBounces"); it != m.end()) {
+        if (!it->is_number_integer() || it->get<int64_t>() < 1 ||
+            it->get<int64_t>() > limits::kMaxBounces)
+            return str("\"maxBounces\" ", it->dump(), " is not in [1, ", limits::kMaxBounces, "]");
+    }
+    if (auto it = m.find("branch"); it != m.end()) {
+        if (*it != "fresnel" && *it != "transmit")
+            return str("\"branch\" ", it->dump(), " is not \"fresnel\" or \"transmit\"");
+    }
+    if (auto it = m.find("input"); it != m.end() && !it->is_string())
+        return "\"input\" is not a string";
+    return "";
 }
 
 // Checks that `part` is a scanline part of width x height with the channels (and types) given.
@@ -628,7 +712,8 @@ std::string sliceName(const json& shard) {
     return str("slice ", shard.value("index", -1), " of ", shard.value("count", -1));
 }
 
-BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
+// `fileBytes`: the file's size, which bounds what its parts can decode to.
+BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options, uint64_t fileBytes) {
     int version = 0;
     json m = openManifest(file, options.verify, &version);
     if (m.contains("shard"))
@@ -650,7 +735,10 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
 
     BakeData d;
     d.order = manifestInt(m, "order");
-    if (d.order < 0 || d.order > 100) throw InputError(str("SH order ", d.order, " is absurd"));
+    if (d.order < 0 || d.order > limits::kMaxOrder)
+        throw InputError(str("SH order ", d.order, " is not in [0, ", limits::kMaxOrder, "]"));
+    if (const std::string problem = manifestProblem(m); !problem.empty())
+        throw InputError("manifest: " + problem);
     const int K = d.coefficientCount();
     if (manifestInt(m, "coefficients") != K)
         throw InputError(str("manifest says ", manifestInt(m, "coefficients"),
@@ -678,6 +766,10 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
         throw InputError(
             str(N, " samples do not fit the ", L.muWidth, " x ", L.muHeight, " mu layout"));
     if (nlLength < 0) throw InputError(str("neighbour list length ", nlLength, " is negative"));
+    for (int side : {L.muWidth, L.muHeight, L.rhoWidth, L.rhoHeight, nlWidth})
+        if (side > limits::kMaxTextureSize)
+            throw InputError(str("manifest sizes are invalid: a side of ", side, " texels is above ",
+                                 limits::kMaxTextureSize));
     U8Params u8;
     if (d.precision == Precision::U8) {
         if (!m.contains("u8")) throw InputError("8-bit bake without \"u8\" scale and offset");
@@ -708,6 +800,15 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
     if (int64_t(nlWidth) * nlHeight < nlLength)
         throw InputError(str("neighbour list of ", nlLength, " entries does not fit its ", nlWidth,
                              " x ", nlHeight, " part"));
+    // zlib inflates at most ~1032:1, so the parts cannot hold more than ~1100 times the file's
+    // bytes: sizes beyond that are corrupt, and are refused before anything is allocated.
+    const uint64_t muTexels = uint64_t(L.muWidth) * uint64_t(L.muHeight);
+    const uint64_t pixelBytes = muTexels * weightsTexelBytes(K, d.precision) + muTexels * (28 + 8) +
+                                uint64_t(L.rhoWidth) * uint64_t(L.rhoHeight) * 16 +
+                                uint64_t(nlWidth) * uint64_t(std::max(nlHeight, 0)) * 8;
+    if (pixelBytes > 1100 * fileBytes + (1u << 20))
+        throw InputError(str("truncated or corrupt: its parts would hold ", pixelBytes,
+                             " bytes, more than a file of ", fileBytes, " bytes can"));
 
     d.weights.assign(size_t(K) * N * 4, 0.0f);
     readWeights(file, pWeights, {nullptr, size_t(N), K, d.precision, L.muWidth, L.muHeight},
@@ -747,6 +848,12 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
 
     const std::string problem = inconsistency(d);
     if (!problem.empty()) throw InputError("inconsistent bake: " + problem);
+    if (auto media = m.find("media"); media != m.end() && !media->empty()) {
+        for (int i = 0; i < N; ++i)
+            if (L.part[i] >= media->size())
+                throw InputError(str("inconsistent bake: sample ", i, " lies on part ", L.part[i],
+                                     " but the manifest has ", media->size(), " media"));
+    }
     d.manifest = std::move(m);
     d.warnings = std::move(warnings);
     return d;
@@ -794,7 +901,10 @@ auto readFile(const std::string& path, Read&& read) {
     if (!std::filesystem::exists(status)) throw inputError(path, "file not found");
     if (std::filesystem::is_directory(status))
         throw inputError(path, "is a directory, not a bake file");
+    if (!std::filesystem::is_regular_file(status))
+        throw inputError(path, "is not a regular file (a FIFO or device?), not a bake file");
 
+    checkExrHeaders(path);  // before OpenEXR allocates what a damaged header claims
     std::unique_ptr<Imf::MultiPartInputFile> file;
     try {
         file = std::make_unique<Imf::MultiPartInputFile>(path.c_str());
@@ -802,7 +912,7 @@ auto readFile(const std::string& path, Read&& read) {
         throw inputError(path, str("not an OpenEXR file: ", e.what()));
     }
     try {
-        return read(*file);
+        return read(*file, uint64_t(std::filesystem::file_size(path, ec)));
     } catch (const InputError& e) {
         throw inputError(path, e.what());
     } catch (const Iex::BaseExc& e) {
@@ -822,7 +932,8 @@ void writeBake(const std::string& path, const BakeData& data) {
         throw std::invalid_argument("writeBake(" + path + "): the manifest is not a JSON object");
     const SurfaceLayout& L = data.layout;
     const U8Params u8 = data.precision == Precision::U8 ? fitU8(data) : U8Params{};
-    const auto [nlWidth, nlHeight] = neighbourListSize(L.neighbourIndex.size());
+    const std::pair<int, int> nlSize = neighbourListSize(L.neighbourIndex.size());
+    const int nlWidth = nlSize.first, nlHeight = nlSize.second;  // (lambdas below capture them)
 
     // The parts' pixels are staged first: their checksums go into the manifest, which every
     // part's header carries.
@@ -897,18 +1008,22 @@ void writeBake(const std::string& path, const BakeData& data) {
     addChannels(headers[3], kNeighbourChannels);
     addChannels(headers[4], kNeighbourListChannels);
 
-    writeAtomically(path, [&](Imf::OStream& stream) {
-        Imf::MultiPartOutputFile file(stream, headers.data(), int(headers.size()));
-        writeWeights(file, 0, weightsPart(data), u8);
-        writeWhole(file, 1, samples, L.muHeight);
-        writeWhole(file, 2, rho, L.rhoHeight);
-        writeWhole(file, 3, neighbours, L.muHeight);
-        writeWhole(file, 4, list, nlHeight);
+    writeAtomically(path, [&](const std::string& staged) {
+        writeExrFile(staged, [&](Imf::OStream& stream) {
+            Imf::MultiPartOutputFile file(stream, headers.data(), int(headers.size()));
+            writeWeights(file, 0, weightsPart(data), u8);
+            writeWhole(file, 1, samples, L.muHeight);
+            writeWhole(file, 2, rho, L.rhoHeight);
+            writeWhole(file, 3, neighbours, L.muHeight);
+            writeWhole(file, 4, list, nlHeight);
+        });
     });
 }
 
 BakeData readBake(const std::string& path, const ReadOptions& options) {
-    return readFile(path, [&](Imf::MultiPartInputFile& file) { return readParts(file, options); });
+    return readFile(path, [&](Imf::MultiPartInputFile& file, uint64_t bytes) {
+        return readParts(file, options, bytes);
+    });
 }
 
 void writeShard(const std::string& path, const ShardData& shard) {
@@ -943,14 +1058,16 @@ void writeShard(const std::string& path, const ShardData& shard) {
                                                    Imath::Box2i({0, 0}, {width - 1, height - 1}),
                                                    text, Imf::NO_COMPRESSION)};
     addChannels(headers[0], weightChannels(K, Precision::F32));
-    writeAtomically(path, [&](Imf::OStream& stream) {
-        Imf::MultiPartOutputFile file(stream, headers.data(), int(headers.size()));
-        writeWeights(file, 0, part, U8Params{});
+    writeAtomically(path, [&](const std::string& staged) {
+        writeExrFile(staged, [&](Imf::OStream& stream) {
+            Imf::MultiPartOutputFile file(stream, headers.data(), int(headers.size()));
+            writeWeights(file, 0, part, U8Params{});
+        });
     });
 }
 
 ShardData readShard(const std::string& path, bool weights) {
-    return readFile(path, [&](Imf::MultiPartInputFile& file) { return readShardParts(file, weights); });
+    return readFile(path, [&](Imf::MultiPartInputFile& file, uint64_t) { return readShardParts(file, weights); });
 }
 
 }  // namespace shrefract

@@ -18,7 +18,9 @@
 #include "bake/bake.h"
 #include "bake/cmd/common_cli.h"
 #include "bake/layout.h"
+#include "common/cli/cli.h"
 #include "common/frame.h"
+#include "common/output.h"
 #include "common/sh.h"
 
 using namespace shrefract;
@@ -48,7 +50,7 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({"coherent", "scalar"}));
     bool noBake = false;
     app.add_flag("--no-bake", noBake, "only the tracing ceilings (skips the whole bake and the GEMM)");
-    CLI11_PARSE(app, argc, argv);
+    return cli::run(app, "shrefract-bench-bake", argc, argv, [&] {
 
     Scene scene = loadScene(input);
     BakeOptions opt;
@@ -176,7 +178,8 @@ int main(int argc, char** argv) {
         out.erase("bake"), out.erase("compression"), out.erase("targets");
         out["samples"] = L.sampleCount();
     }
-    std::ofstream(json) << out.dump(2) << "\n";
+    writeFile(json, out.dump(2) + "\n");
     std::printf("%s\n", out.dump(2).c_str());
-    return 0;
+    return int(cli::kOk);
+    });
 }

@@ -2,26 +2,25 @@
 // A thin shell over bake/ (bake.h); options in docs/bake.md.
 #include <CLI/CLI.hpp>
 
-#include <atomic>
 #include <chrono>
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 
 #include "bake/bake.h"
 #include "bake/layout.h"
 #include "bake/shard.h"
 #include "bake/target.h"
 #include "bake/cmd/common_cli.h"
+#include "common/cli/cli.h"
 #include "common/error.h"
+#include "common/limits.h"
+#include "common/output.h"
 
 using namespace shrefract;
 namespace fs = std::filesystem;
 
 namespace {
-std::atomic<bool> gCancel{false};
-void onSignal(int) { gCancel = true; }
+constexpr const char* kTool = "shrefract-bake";
 using Clock = std::chrono::steady_clock;
 }  // namespace
 
@@ -39,18 +38,18 @@ int main(int argc, char** argv) {
     std::string targetReport;
     app.add_option("input", input, "mesh (.obj .off .ply .stl) or scene (.json)")->required();
     app.add_option("-o,--output", output, "output file, NAME.shrefract.exr")->required();
-    app.add_option("--order", opt.order, "SH order L: bands 0..L")->capture_default_str()->check(CLI::Range(0, 20));
+    app.add_option("--order", opt.order, "SH order L: bands 0..L")->capture_default_str()->check(CLI::Range(0, limits::kMaxOrder));
     auto* rateOpt = app.add_option("--rate", rate, "grid steps per triangle edge (overrides --samples)")
-                        ->check(CLI::Range(1, 64));
+                        ->check(CLI::Range(1, limits::kMaxRate));
     app.add_option("--samples", samples, "target number of unique surface samples")
         ->capture_default_str()->check(CLI::Range(size_t(1), size_t(50'000'000)))->excludes(rateOpt);
     app.add_option("--grid", grid, "view directions over the hemisphere, NTHETAxNPHI")->capture_default_str();
-    app.add_option("--ior", ior, "index of refraction for a bare mesh")->capture_default_str()->check(CLI::Range(1.0, 5.0));
+    app.add_option("--ior", ior, "index of refraction for a bare mesh")->capture_default_str()->check(CLI::Range(limits::kMinIor, limits::kMaxIor));
     app.add_option("--branch", branch, "fresnel: larger Fresnel branch; transmit: refract unless TIR")
         ->capture_default_str()->check(CLI::IsMember({"fresnel", "transmit"}));
-    app.add_option("--max-bounces", opt.trace.maxBounces, "bounce cap per path")->capture_default_str()->check(CLI::Range(1, 10000));
+    app.add_option("--max-bounces", opt.trace.maxBounces, "bounce cap per path")->capture_default_str()->check(CLI::Range(1, limits::kMaxBounces));
     app.add_option("--filter", opt.filterWidth, "semi-Gaussian SH low-pass width in bands (0: none)")
-        ->capture_default_str()->check(CLI::Range(0.0, 1000.0));
+        ->capture_default_str()->check(CLI::Range(0.0, limits::kMaxFilterWidth));
     std::string fit = ToString(opt.fit), weighting = opt.weighting.ToString();
     app.add_option("--fit", fit, "projection: W = M R through the compression matrix (the paper); lsq: "
                                  "least squares on the grid samples; weighted: least squares weighted by "
@@ -89,11 +88,13 @@ int main(int argc, char** argv) {
                                        "one ray at a time (the reference)")
         ->capture_default_str()->check(CLI::IsMember({"coherent", "scalar"}));
     app.add_flag("-q,--quiet", quiet, "no progress output");
-    CLI11_PARSE(app, argc, argv);
     const auto start = Clock::now();
     std::string checkpointDir;  // set once a checkpointed bake has begun
 
-    try {
+    return cli::run(app, kTool, argc, argv, [&] {
+      try {
+        // Stop cleanly on Ctrl-C or SIGTERM: the bake polls the flag, nothing is written.
+        opt.cancel = cli::cancelOnSignals();
         opt.rate = rate;
         opt.samples = samples;
         opt.grid = parseGrid(grid, "--grid");
@@ -111,9 +112,11 @@ int main(int argc, char** argv) {
                                  "once, then shard with the --order, --rate and --grid it chose");
         }
         if (workDir.empty()) workDir = output + ".work";
-        fs::path outDir = fs::absolute(output).parent_path();
-        if (!fs::is_directory(outDir))
-            throw inputError(output, "output folder " + outDir.string() + " does not exist");
+        // Every output checked and staged before the work: a bad path fails now, not after an
+        // hour of tracing, and nothing appears under its name until all are complete.
+        OutputSet outputs;
+        const std::string stagedBake = outputs.add(output);
+        const std::string stagedReport = targetReport.empty() ? "" : outputs.add(targetReport);
 
         Medium medium;
         medium.ior = ior;
@@ -136,11 +139,7 @@ int main(int argc, char** argv) {
             std::printf("  chosen: %.1f MB of weights (%.2fx less), %.3g paths (%.2fx less)\n", c.weightBytes / 1e6,
                         double(p.weightBytes) / std::max<size_t>(1, c.weightBytes), c.bakeCost,
                         p.bakeCost / std::max(1.0, c.bakeCost));
-            if (!targetReport.empty()) {
-                std::ofstream f(targetReport);
-                f << t.ToJson().dump(2) << "\n";
-                if (!f) throw inputError(targetReport, "cannot write");
-            }
+            if (!targetReport.empty()) writeFile(stagedReport, t.ToJson().dump(2) + "\n");
             opt.order = c.order;
             opt.rate = c.rate;
             opt.grid = c.grid;
@@ -167,18 +166,23 @@ int main(int argc, char** argv) {
                 }
             };
         }
-        std::signal(SIGINT, onSignal);
-        std::signal(SIGTERM, onSignal);
-        opt.cancel = &gCancel;
+        if (opt.rate == 0) {
+            // Say what --samples becomes: the smallest rate reaching it, usually more samples.
+            opt.rate = rateForSampleCount(scene, opt.samples);
+            const size_t n = joiningSampleCount(scene, opt.rate);
+            if (n != opt.samples)
+                cli::note(kTool, "--samples " + std::to_string(opt.samples) + ": rate " +
+                                     std::to_string(opt.rate) + " gives " + std::to_string(n) +
+                                     " unique samples (" +
+                                     (n > opt.samples ? "the smallest rate that reaches it"
+                                                      : "the largest rate; it cannot reach it") +
+                                     ")");
+        }
 
         auto note = [&](const std::string& text) {
             if (!quiet) std::fprintf(stderr, "%s%s\n", tty ? "\r" : "", text.c_str());
         };
         BakePlan plan(scene, opt, input);
-        if (resume) {
-            const int stale = removeStaleTemporaries(output);
-            if (stale > 0) note("resume: removed " + std::to_string(stale) + " temporary file(s) a killed bake left");
-        }
         if (!shardText.empty()) {
             // One slice into a shard file, for shrefract-merge.
             if (resume && fs::exists(output)) {
@@ -187,7 +191,7 @@ int main(int argc, char** argv) {
                     if (shardMismatch(old, shardIdentity(plan), slice, plan.batchCount()).empty()) {
                         std::printf("%s: slice %d of %d is already complete\n", output.c_str(),
                                     slice.index, slice.count);
-                        return 0;
+                        return int(cli::kOk);
                     }
                 } catch (const InputError& e) {
                     note(std::string("baking it again: ") + e.what());
@@ -195,7 +199,9 @@ int main(int argc, char** argv) {
             }
             const ShardData shard = bakeShard(plan, slice);
             if (!quiet && tty) std::fprintf(stderr, "\n");
-            writeShard(output, shard);
+            writeShard(stagedBake, shard);
+            if (opt.cancel->load()) throw Cancelled();  // a signal during the write: keep nothing
+            outputs.commit();
             const BakeStats st = BakeStats::fromJson(shard.manifest["stats"]);
             std::printf("baked %s slice %d of %d -> %s\n", input.c_str(), slice.index, slice.count,
                         output.c_str());
@@ -205,7 +211,7 @@ int main(int argc, char** argv) {
             std::printf("  time        %.1f s wall (layout %.1f s, slice %.1f s)\n",
                         std::chrono::duration<double>(Clock::now() - start).count(), plan.setupSeconds(),
                         st.wallSeconds);
-            return 0;
+            return int(cli::kOk);
         }
         const int nCheckpoints = checkpointCount(plan, checkpoints);
         BakeResult res;
@@ -224,8 +230,9 @@ int main(int argc, char** argv) {
         }
         res.stats.rhoOverhead = rhoOverhead(plan.layout());
         if (!quiet && tty) std::fprintf(stderr, "\n");
-        if (gCancel) throw Cancelled();
-        writeBake(output, res.data);
+        writeBake(stagedBake, res.data);
+        if (opt.cancel->load()) throw Cancelled();  // a signal during the write: keep nothing
+        outputs.commit();
         if (nCheckpoints > 1) removeCheckpoints(workDir);
         res.stats.wallSeconds = std::chrono::duration<double>(Clock::now() - start).count();
 
@@ -251,18 +258,12 @@ int main(int argc, char** argv) {
         std::printf("  file        %.1f MB, order %d, %d coefficients, %s\n",
                     std::filesystem::file_size(output) / 1e6, opt.order, res.data.coefficientCount(),
                     precision.c_str());
-        return 0;
-    } catch (const Cancelled&) {
-        std::fprintf(stderr, "\nshrefract-bake: cancelled; no file written\n");
+        return int(cli::kOk);
+      } catch (const Cancelled&) {
         if (!checkpointDir.empty())
-            std::fprintf(stderr, "shrefract-bake: finished checkpoints stay in %s: run the same "
-                                 "command with --resume to continue\n", checkpointDir.c_str());
-        return 130;
-    } catch (const InputError& e) {
-        std::fprintf(stderr, "shrefract-bake: error: %s\n", e.what());
-        return 2;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "shrefract-bake: error: %s\n", e.what());
-        return 1;
-    }
+            std::fprintf(stderr, "\n%s: finished checkpoints stay in %s: run the same command with "
+                                 "--resume to continue\n", kTool, checkpointDir.c_str());
+        throw;
+      }
+    });
 }

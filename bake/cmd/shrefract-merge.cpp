@@ -8,7 +8,9 @@
 #include <filesystem>
 
 #include "bake/shard.h"
+#include "common/cli/cli.h"
 #include "common/error.h"
+#include "common/output.h"
 
 using namespace shrefract;
 namespace fs = std::filesystem;
@@ -25,21 +27,19 @@ int main(int argc, char** argv) {
                    "mesh or scene to rebuild the layout from (default: the path the shards "
                    "record); its checksum must match theirs");
     app.add_flag("-q,--quiet", quiet, "no notes on stderr");
-    CLI11_PARSE(app, argc, argv);
-
     const auto t0 = std::chrono::steady_clock::now();
-    try {
-        const fs::path outDir = fs::absolute(output).parent_path();
-        if (!fs::is_directory(outDir))
-            throw inputError(output, "output folder " + outDir.string() + " does not exist");
+    return cli::run(app, "shrefract-merge", argc, argv, [&] {
         for (const std::string& s : shards)
             if (fs::exists(s) && fs::equivalent(s, output))
                 throw inputError(output, "is one of the shards: the output would overwrite it");
+        OutputSet outputs;  // checked and staged before the work; see common/output.h
+        const std::string staged = outputs.add(output);
         MergeOptions options;
         options.input = input;
         if (!quiet) options.log = [](const std::string& text) { std::fprintf(stderr, "%s\n", text.c_str()); };
         BakeResult res = mergeShards(shards, options);
-        writeBake(output, res.data);
+        writeBake(staged, res.data);
+        outputs.commit();
         const BakeStats& s = res.stats;
         std::printf("merged %zu shards -> %s\n", shards.size(), output.c_str());
         std::printf("  samples     %zu, paths %zu, rays %zu\n", s.samples, s.paths, s.rays);
@@ -47,12 +47,6 @@ int main(int argc, char** argv) {
                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
                     s.wallSeconds);
         std::printf("  file        %.1f MB\n", fs::file_size(output) / 1e6);
-        return 0;
-    } catch (const InputError& e) {
-        std::fprintf(stderr, "shrefract-merge: error: %s\n", e.what());
-        return 2;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "shrefract-merge: error: %s\n", e.what());
-        return 1;
-    }
+        return int(cli::kOk);
+    });
 }

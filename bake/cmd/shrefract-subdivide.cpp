@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "bake/subdivide.h"
+#include "common/cli/cli.h"
 #include "common/error.h"
 
 using namespace shrefract;
@@ -18,17 +19,10 @@ int main(int argc, char** argv) {
     app.add_option("--scheme", scheme, "loop (x4 triangles) or sqrt3 (x3 triangles)")
         ->capture_default_str()->check(CLI::IsMember({"loop", "sqrt3"}));
     app.add_option("--steps", steps, "subdivision steps")->capture_default_str()->check(CLI::Range(0, 6));
-    CLI11_PARSE(app, argc, argv);
-    try {
+    return cli::run(app, "shrefract-subdivide", argc, argv, [&] {
         const SubdivisionResult r = subdivideMeshFile(input, output, parseSubdivision(scheme), steps);
         std::printf("%s -> %s: %zu vertices, %zu triangles\n", input.c_str(), output.c_str(), r.vertices,
                     r.triangles);
-        return 0;
-    } catch (const InputError& e) {
-        std::fprintf(stderr, "shrefract-subdivide: error: %s\n", e.what());
-        return 2;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "shrefract-subdivide: error: %s\n", e.what());
-        return 1;
-    }
+        return int(cli::kOk);
+    });
 }

@@ -2,19 +2,21 @@
 // SH runtime, a baseline or the ray-traced reference (README "shrefract-render").
 // A thin shell over the runtime library (shrefract/render.h, shrefract/baselines.h) and, for
 // raytrace and Wyman's d_N, the evaluation layer (eval/reference.h, Embree through bake/): the
-// runtime library itself never links the bake. Bad input: message, exit 1, and no output file.
+// runtime library itself never links the bake. Every output is checked before the render and
+// written only when all succeed (common/output.h); exit codes as every tool's (README).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <functional>
 #include <sstream>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
+#include "common/cli/cli.h"
 #include "common/error.h"
 #include "common/evalbuffer.h"
+#include "common/output.h"
 #include "common/tonemap.h"
 #include "eval/directions.h"
 #include "eval/reference.h"
@@ -146,9 +148,13 @@ int main(int argc, char** argv) {
                    "sh with --ior: a second bake of the same mesh at another index, interpolated "
                    "with BAKE per channel instead of the straight path");
     app.add_flag("--no-verify", noVerify, "skip the bake's checksums (faster; a corrupt file may draw garbage)");
-    CLI11_PARSE(app, argc, argv);
-
-    try {
+    return shrefract::cli::run(app, "shrefract-render", argc, argv, [&] {
+        // Outputs first: a path that cannot be written fails before any rendering.
+        shrefract::OutputSet outputs;
+        const std::string stagedPng = out.empty() ? "" : outputs.add(out);
+        const std::string stagedExr = outExr.empty() ? "" : outputs.add(outExr);
+        const std::string stagedDirs = dirs.empty() ? "" : outputs.add(dirs);
+        const std::string stagedFlicker = flickerJson.empty() ? "" : outputs.add(flickerJson);
         int width = 0, height = 0;
         char x = 0;
         std::istringstream sizeStream(size);
@@ -205,6 +211,10 @@ int main(int argc, char** argv) {
         Bake bake = loadBake(bakePath, !noVerify);
         for (const std::string& w : bake.warnings())
             std::fprintf(stderr, "shrefract-render: warning: %s: %s\n", bakePath.c_str(), w.c_str());
+        if (order < -1 || order > bake.order())
+            throw std::invalid_argument("--order " + std::to_string(order) + ": " + bakePath +
+                                        " stores orders 0.." + std::to_string(bake.order()) +
+                                        " (-1: all)");
         std::vector<float> kappa;
         if (!absorption.empty()) {
             kappa = parseFloats(absorption, 3, "--absorption");
@@ -362,13 +372,10 @@ int main(int argc, char** argv) {
             mean /= double(diffs.size());
             std::printf("flicker: %d frames %g deg apart, mean |frame - previous| = %.6f (tone-mapped)\n",
                         flickerFrames, flickerStep, mean);
-            if (!flickerJson.empty()) {
-                std::ofstream jf(flickerJson);
-                jf << nlohmann::json{{"method", method}, {"frames", flickerFrames}, {"stepDeg", flickerStep},
-                                     {"meanAbsDifference", mean}, {"differences", diffs}}.dump(1)
-                   << "\n";
-                if (!jf) throw InputError(flickerJson + ": cannot write");
-            }
+            if (!flickerJson.empty())
+                writeFile(stagedFlicker,
+                          nlohmann::json{{"method", method}, {"frames", flickerFrames}, {"stepDeg", flickerStep},
+                                         {"meanAbsDifference", mean}, {"differences", diffs}}.dump(1) + "\n");
             msPerFrame = ms;
         } else {
             // A first frame warms up (llvmpipe JIT-compiles shaders at first draw); the time
@@ -400,12 +407,12 @@ int main(int argc, char** argv) {
         size_t covered = 0;
         for (size_t i = 3; i < frame.directions.size(); i += 4) covered += frame.directions[i] > 0;
         std::printf("coverage: %.1f%% of pixels\n", 100.0 * covered / (size_t(width) * height));
-        if (!out.empty()) writePng(out, frame, exposure);
-        if (!outExr.empty()) writeExr(outExr, width, height, frame.color);
-        if (!dirs.empty()) writeEvalBuffer(dirs, makeEvalBuffer(width, height, frame.color, frame.directions));
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "shrefract-render: %s\n", e.what());
-        return 1;
-    }
-    return 0;
+        if (!out.empty()) shrefract::writePng(stagedPng, frame, exposure);
+        if (!outExr.empty()) shrefract::writeExr(stagedExr, width, height, frame.color);
+        if (!dirs.empty())
+            shrefract::writeEvalBuffer(
+                stagedDirs, shrefract::makeEvalBuffer(width, height, frame.color, frame.directions));
+        outputs.commit();  // all or none
+        return shrefract::cli::kOk;
+    });
 }

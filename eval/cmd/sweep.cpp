@@ -15,13 +15,16 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
 
 #include "bake/bake.h"
 #include "gl.h"  // glFinish, through the runtime's loader
 #include "eval/image_eval.h"
 #include "bake/layout.h"
 #include "eval/reference.h"
+#include "common/cli/cli.h"
 #include "common/latlong.h"
+#include "common/output.h"
 #include "common/sh.h"
 #include "shrefract/baselines.h"
 #include "shrefract/context.h"
@@ -81,9 +84,11 @@ int main(int argc, char** argv) {
     app.add_option("--bake", bakePath,
                    "with --table1: render this bake of --mesh instead of baking (its manifest "
                    "gives samples, rays and bake seconds)");
-    CLI11_PARSE(app, argc, argv);
-
-    try {
+    return cli::run(app, "shrefract-sweep", argc, argv, [&] {
+        // The outputs are checked before hours of work, and written only when all succeed.
+        OutputSet outputs;
+        const std::string stagedJson = outputs.add(jsonPath);
+        const std::string stagedCsv = csvPath.empty() ? "" : outputs.add(csvPath);
         Medium medium;
         medium.ior = ior;
         Scene scene = loadScene(mesh, medium);
@@ -132,9 +137,10 @@ int main(int argc, char** argv) {
                                   {"triangles", triangles}, {"muSize", res.data.layout.muWidth},
                                   {"memoryMB", r->memory().total() / 1e6}, {"msFrame", ms[ms.size() / 2]},
                                   {"bakeSeconds", res.stats.wallSeconds}, {"renderer", context->description()}};
-            std::ofstream(jsonPath) << row.dump(2) << "\n";
+            writeFile(stagedJson, row.dump(2) + "\n");
+            outputs.commit();
             std::printf("%s\n", row.dump().c_str());
-            return 0;
+            return cli::kOk;
         }
 
         // Two views around the object, at 2.5 bounding radii.
@@ -329,9 +335,9 @@ int main(int argc, char** argv) {
             j["family"] = p.family, j["label"] = p.label, j["value"] = p.value;
             out["points"].push_back(j);
         }
-        std::ofstream(jsonPath) << out.dump(2) << "\n";
+        writeFile(stagedJson, out.dump(2) + "\n");
         if (!csvPath.empty()) {
-            std::ofstream csv(csvPath);
+            std::ostringstream csv;
             csv << "family,label,value,medianDeg,p95Deg,psnr,ssim,msFrame,memoryMB,bakeSeconds\n";
             for (const Point& p : points) {
                 const auto& m = p.metrics;
@@ -340,11 +346,10 @@ int main(int argc, char** argv) {
                     << m.value("msFrame", 0.0) << ',' << m.value("memoryMB", 0.0) << ',' << m.value("bakeSeconds", 0.0)
                     << '\n';
             }
+            writeFile(stagedCsv, csv.str());
         }
+        outputs.commit();
         std::printf("wrote %s (%zu points)\n", jsonPath.c_str(), points.size());
-        return 0;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "shrefract-sweep: error: %s\n", e.what());
-        return 1;
-    }
+        return cli::kOk;
+    });
 }

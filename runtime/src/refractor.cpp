@@ -228,6 +228,10 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
     const int n = L.sampleCount();
     if (n == 0 || L.muWidth * L.muHeight < n || L.triangleCount == 0)
         throw std::invalid_argument("shrefract: bake has an empty or inconsistent layout");
+    if (options.order < -1 || options.maxOrder < -1)
+        throw std::invalid_argument("shrefract: RefractorOptions order " +
+                                    std::to_string(options.order) + ", maxOrder " +
+                                    std::to_string(options.maxOrder) + ": -1 (all) or 0 and up");
     m->maxOrder = options.maxOrder < 0 ? d.order : std::min(options.maxOrder, d.order);
     m->order = options.order < 0 ? m->maxOrder : std::min(options.order, m->maxOrder);
     m->smoothing = options.smoothing;
@@ -747,8 +751,12 @@ std::string Refractor::path() const { return impl_->direct ? "direct" : "rho"; }
 std::string Refractor::decompression() const { return impl_->vertexMode() ? "vertex" : "texture"; }
 
 void Refractor::setOrder(int L) {
+    // As RefractorOptions::order: -1 is every uploaded band, above maxOrder clamps to it.
+    if (L < -1)
+        throw std::invalid_argument("shrefract: setOrder(" + std::to_string(L) +
+                                    "): -1 (all) or 0 and up");
     impl_->use();
-    impl_->order = std::clamp(L, 0, impl_->maxOrder);
+    impl_->order = L < 0 ? impl_->maxOrder : std::min(L, impl_->maxOrder);
     impl_->compiledFor(impl_->order);
 }
 int Refractor::order() const { return impl_->order; }

@@ -110,7 +110,7 @@ TEST(Resume, AfterSigkillAtRandomMomentsResumeGivesTheSameFile) {
         if (fs::exists(work)) {
             for (const auto& e : fs::directory_iterator(work)) {
                 const std::string name = e.path().filename().string();
-                if (name == "lock" || name.find(".tmp.") != std::string::npos) continue;
+                if (name == "lock" || name.find(".shrefract-tmp.") != std::string::npos) continue;
                 try {
                     readShard(e.path().string());
                     ++complete;

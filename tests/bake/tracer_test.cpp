@@ -160,6 +160,30 @@ TEST(Tracer, NestedMediaResolvedByPriority) {
     EXPECT_EQ(r.bounces, 4);  // cavity top, water top, water bottom (into glass), glass bottom
 }
 
+// Equal priorities: the medium entered last is in effect (DESIGN §3, "ties: the most recently
+// entered"). A water slab (1.33) inside a glass slab (1.5), both priority 0: between the water's
+// faces the path is in water, so it bends there; if the glass, entered first, won the tie, the
+// water's faces would be no interfaces and the path would stay in glass.
+TEST(Tracer, EqualPrioritiesGoToTheMediumEnteredLast) {
+    Scene s = sceneOf(flatBox({-5, -5, -1}, {5, 5, 1}), 1.5, /*priority=*/0);
+    Part water;
+    water.name = "water";
+    water.mesh = flatBox({-4, -4, -0.3f}, {4, 4, 0.3f});
+    water.medium.ior = 1.33;
+    water.medium.priority = 0;
+    s.parts.push_back(water);
+    Tracer tracer(s);
+    const float theta = 50;
+    const glm::vec3 omega = fromAngles(theta, 0);
+    PathResult r = tracer.trace({0, 0, 1}, {0, 0, 1}, omega, 0);
+    auto cosIn = [&](double n) { double st = std::sin(theta * kPi / 180) / n; return std::sqrt(1 - st * st); };
+    const double expected = 1.4 / cosIn(1.5) + 0.6 / cosIn(1.33);  // glass 0.7 + 0.7, water 0.6
+    ASSERT_GT(std::abs(expected - 2.0 / cosIn(1.5)), 1e-2);      // what glass-wins would give
+    EXPECT_NEAR(r.length, expected, 1e-3);  // ray offsets scale with the scene: measured 1.4e-4
+    EXPECT_EQ(r.bounces, 3);  // water top, water bottom, glass bottom
+    EXPECT_NEAR(glm::dot(r.exit, -omega), 1.0f, 1e-5f) << str(r.exit);
+}
+
 // Near the critical angle Fresnel exceeds 1/2 without TIR: the Fresnel branch reflects, the
 // transmit branch refracts. In a wide slab the reflected path bounces between the faces until
 // half the cap, then is forced out (rule 5) and flagged.
@@ -182,6 +206,44 @@ TEST(Tracer, FresnelBranchReflectsAndSoftCapEndsThePath) {
     // 16 reflections: it leaves through the bottom face, along the entry direction again.
     EXPECT_NEAR(glm::dot(f.exit, -omega), 1.0f, 1e-4f) << str(f.exit);
     EXPECT_FALSE(f.flags & kPathCapped);
+}
+
+// The branch threshold is F = 1/2 exactly (DESIGN §3 rule 2: the larger branch). In a wide slab
+// of glass the ray meets the bottom face at the refraction angle; aim it so that the Fresnel
+// reflectance there (closed form from the angles, in double, independent of optics.h) is 0.45,
+// then 0.55. At 0.45 it leaves through the bottom at once, along its entry direction; at 0.55 it
+// reflects and bounces between the faces until the soft cap (16) forces it out.
+TEST(Tracer, FresnelBranchThresholdIsOneHalf) {
+    Scene s = sceneOf(flatBox({-100, -100, -0.5f}, {100, 100, 0.5f}), 1.5);
+    Tracer tracer(s, TraceOptions{Branch::Fresnel, 32});
+    // Reflectance from inside glass (1.5) toward air at internal angle t, the Fresnel equations.
+    auto insideF = [](double t) {
+        const double st = 1.5 * std::sin(t);
+        if (st >= 1) return 1.0;
+        const double o = std::asin(st);
+        return 0.5 * (std::pow(std::sin(t - o) / std::sin(t + o), 2) +
+                      std::pow(std::tan(t - o) / std::tan(t + o), 2));
+    };
+    for (double target : {0.45, 0.55}) {
+        double lo = 0.5, hi = std::asin(1 / 1.5);  // F rises monotonically to 1 at the critical angle
+        for (int i = 0; i < 60; ++i) (insideF(0.5 * (lo + hi)) < target ? lo : hi) = 0.5 * (lo + hi);
+        const double internal = 0.5 * (lo + hi);
+        const double entry = std::asin(1.5 * std::sin(internal));  // Snell at the top face
+        const glm::vec3 omega = fromAngles(float(entry * 180 / kPi), 0);
+        PathResult r = tracer.trace({0, 0, 0.5f}, {0, 0, 1}, omega, 0);
+        SCOPED_TRACE("F = " + std::to_string(target) + " at " + std::to_string(internal * 180 / kPi) + " deg inside");
+        // Lengths to 0.5% (ray offsets scale with this 200-unit scene: measured 0.12%); the two
+        // branches differ 17-fold.
+        if (target < 0.5) {
+            EXPECT_EQ(r.bounces, 1);
+            EXPECT_NEAR(r.length, 1.0 / std::cos(internal), 5e-3 / std::cos(internal));
+        } else {
+            EXPECT_EQ(r.bounces, 17);  // 16 reflections, then the forced transmission
+            EXPECT_TRUE(r.flags & kPathSoftCapped);
+            EXPECT_NEAR(r.length, 17.0 / std::cos(internal), 5e-3 * 17.0 / std::cos(internal));
+        }
+        EXPECT_NEAR(glm::dot(r.exit, -omega), 1.0f, 1e-4f) << str(r.exit);
+    }
 }
 
 // A path that re-enters: a second glass block beside the first, in the exit's way.

@@ -56,9 +56,11 @@ Bake makeBake(BakeData data);
 // Lat-long convention: +y up; u = 0.5 + atan2(d.x, -d.z) / 2pi, v = acos(d.y) / pi (row 0 top).
 class Environment {
 public:
-    // Loads a lat-long EXR into a cube map of `faceSize` (0: height / 2); throws InputError.
+    // Loads a lat-long EXR into a cube map of `faceSize` (0: height / 2); throws InputError naming
+    // the file: missing, not an image, a bake, not 2:1 (+-1 pixel), NaN or inf pixels.
     static Environment loadLatLong(const std::string& path, int faceSize = 0);
-    // Builds the cube map from lat-long RGB floats, row-major, row 0 = top (+y).
+    // Builds the cube map from lat-long RGB floats, row-major, row 0 = top (+y): 2:1 (+-1 pixel),
+    // every value finite, else std::invalid_argument.
     static Environment fromLatLong(int width, int height, const std::vector<float>& rgb,
                                    int faceSize = 0);
     Environment(Environment&&) noexcept;
@@ -123,7 +125,8 @@ struct RefractorOptions {
     // draw; needs a one-pass preset and no smoothing); "texture": decompression passes into D_mu
     // first; "auto": the measured default (docs/runtime.md).
     std::string decompression = "auto";
-    int order = -1;                 // SH order used, -1: all stored
+    int order = -1;                 // SH order used, -1: all uploaded; above maxOrder clamps
+                                    // to it (order() tells); below -1: std::invalid_argument
     int maxOrder = -1;              // bands uploaded to the GPU, 0..maxOrder (-1: all stored);
                                     // setOrder() cannot go above it
     // Float32 bakes upload as RGBA16F (half the memory). f16 bakes are always RGBA16F, u8 bakes
@@ -164,7 +167,8 @@ public:
     glm::ivec2 refractionMapSize() const;
     std::string path() const;           // "rho" or "direct"
     std::string decompression() const;  // "texture" or "vertex"
-    // Progressive decompression (paper §6): use bands 0..L, clamped to the uploaded maxOrder.
+    // Progressive decompression (paper §6): use bands 0..L, as RefractorOptions::order does:
+    // -1 is all uploaded bands, above maxOrder clamps to it, below -1 is std::invalid_argument.
     void setOrder(int L);
     int order() const;
     void setSmoothing(bool on);

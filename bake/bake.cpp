@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 
 #include "bake/layout.h"
+#include "common/checksum.h"
 #include "common/error.h"
 #include "common/frame.h"
 #include "common/sh.h"
@@ -25,9 +26,52 @@ double secondsSince(Clock::time_point t0) {
     return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-// Samples per GEMM: R is J x 4B. 32 keeps R (2048 x 128 floats = 1 MiB) in L2-ish reach and
-// leaves enough batches for load balance.
-constexpr int kBatch = 32;
+// The mean over the sample's footprint (--footprint-samples N > 1): N - 1 points along the
+// segments to its grid neighbours (listed after the sample itself), spread evenly over them, at
+// a quarter and two fifths of the way, traced with the same object-space view directions
+// omegas[j]; paths[j] becomes the mean exit vector and length (its flags stay the sample's).
+// Returns the rays traced.
+size_t averageOverFootprint(const Tracer& tracer, const SurfaceLayout& L, size_t i, int footprintSamples,
+                            bool coherent, const std::vector<glm::vec3>& omegas, std::vector<PathResult>& paths) {
+    thread_local std::vector<glm::vec3> sumExit, seen;
+    thread_local std::vector<float> sumLength;
+    thread_local std::vector<int> used;
+    thread_local std::vector<uint32_t> visible;
+    thread_local std::vector<PathResult> traced;
+    const size_t J = omegas.size();
+    sumExit.resize(J), sumLength.resize(J), used.assign(J, 1);
+    for (size_t j = 0; j < J; ++j) sumExit[j] = paths[j].exit, sumLength[j] = paths[j].length;
+    const uint32_t first = L.neighbourOffset[i] + 1, others = L.neighbourCount[i] - 1;
+    const uint32_t extra = uint32_t(footprintSamples - 1);
+    size_t rays = 0;
+    for (int f = 1; f < footprintSamples && others > 0; ++f) {
+        const uint32_t nb = L.neighbourIndex[first + (uint32_t(f - 1) * others) / extra];
+        const float t = f % 2 ? 0.25f : 0.4f;
+        const glm::vec3 pf = glm::mix(L.position[i], L.position[nb], t);
+        const glm::vec3 nf = glm::normalize(glm::mix(L.normal[i], L.normal[nb], t));
+        // The directions that see the point from above (elsewhere the view is below it).
+        visible.clear(), seen.clear();
+        for (size_t j = 0; j < J; ++j)
+            if (glm::dot(nf, omegas[j]) > 0.0f) visible.push_back(uint32_t(j)), seen.push_back(omegas[j]);
+        traced.resize(seen.size());
+        if (coherent)
+            tracer.traceCoherent(pf, nf, seen.data(), seen.size(), L.part[i], traced.data());
+        else
+            for (size_t k = 0; k < seen.size(); ++k) traced[k] = tracer.trace(pf, nf, seen[k], L.part[i]);
+        for (size_t k = 0; k < visible.size(); ++k) {
+            const uint32_t j = visible[k];
+            sumExit[j] += traced[k].exit;
+            sumLength[j] += traced[k].length;
+            rays += traced[k].rays;
+            ++used[j];
+        }
+    }
+    for (size_t j = 0; j < J; ++j) {
+        paths[j].exit = sumExit[j] / float(used[j]);
+        paths[j].length = sumLength[j] / float(used[j]);
+    }
+    return rays;
+}
 
 }  // namespace
 
@@ -55,81 +99,151 @@ std::vector<int> evenBands(int L) {
     return bands;
 }
 
-BakeResult bake(const Scene& scene, const BakeOptions& opt, const std::string& inputPath) {
+BakeStats& BakeStats::operator+=(const BakeStats& o) {
+    samples += o.samples, paths += o.paths, rays += o.rays;
+    tir += o.tir, capped += o.capped, softCapped += o.softCapped, reentered += o.reentered;
+    geometricNormal += o.geometricNormal, leaked += o.leaked;
+    traceSeconds += o.traceSeconds, compressSeconds += o.compressSeconds;
+    wallSeconds += o.wallSeconds;
+    return *this;
+}
+
+nlohmann::json BakeStats::ToJson() const {
+    return {{"paths", paths}, {"rays", rays}, {"tir", tir}, {"capped", capped},
+            {"softCapped", softCapped}, {"reentered", reentered},
+            {"geometricNormal", geometricNormal}, {"leaked", leaked}, {"seconds", wallSeconds}};
+}
+
+BakeStats BakeStats::fromJson(const nlohmann::json& j) {
+    BakeStats s;
+    auto count = [&](const char* key) { return j.value(key, size_t(0)); };
+    s.paths = count("paths"), s.rays = count("rays"), s.tir = count("tir");
+    s.capped = count("capped"), s.softCapped = count("softCapped");
+    s.reentered = count("reentered"), s.geometricNormal = count("geometricNormal");
+    s.leaked = count("leaked");
+    s.wallSeconds = j.value("seconds", 0.0);
+    return s;
+}
+
+// How a batch's R becomes its weights. Projection and least squares: W^T = R^T M^T, the matrix
+// in float for the GEMM with the band filter folded into its rows (filtering the weights equals
+// filtering M's rows: diag(h) (M R) = (diag(h) M) R), stored transposed: the GEMM then yields
+// W^T, whose column k (coefficient k of every sample in the batch, x y z len interleaved) is one
+// contiguous copy into the weights. The weighted fit solves per sample instead.
+struct BakePlan::Compression {
+    Eigen::MatrixXf Mt;
+    std::unique_ptr<WeightedFitter> fitter;  // Fit::Weighted only
+    std::vector<double> h;                   // band filter, per band
+    std::vector<int> band;                   // band of each stored coefficient
+    std::vector<glm::vec3> dirs;             // grid directions, local frame
+    std::vector<uint32_t> order;             // the order they are traced in: packetOrder(grid)
+};
+
+BakePlan::BakePlan(const Scene& scene, const BakeOptions& opt, const std::string& inputPath)
+    : scene_(scene), opt_(opt), input_(inputPath) {
     const auto t0 = Clock::now();
-    std::unique_ptr<tbb::global_control> threads;
-    if (opt.threads > 0)
-        threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                        opt.threads);
-    BakeResult out;
-    BakeData& data = out.data;
-    data.order = opt.order;
-    data.precision = opt.precision;
     if (opt.layout == LayoutKind::Joining) {
         const int rate = opt.rate > 0 ? opt.rate : rateForSampleCount(scene, opt.samples);
-        data.layout = buildJoiningLayout(scene, rate);
+        layout_ = buildJoiningLayout(scene, rate);
     } else {
         ChartOptions co = opt.charts;
         co.kind = opt.layout;
         co.samples = opt.samples;
-        data.layout = buildChartLayout(scene, co, &out.stats.charts);
+        layout_ = buildChartLayout(scene, co, &charts_);
     }
-    const SurfaceLayout& L = data.layout;
+    setupSeconds_ = secondsSince(t0);
+}
+
+BakePlan::~BakePlan() = default;
+
+void BakePlan::prepareTracing() const {
+    std::call_once(prepared_, [&] {
+        const int K = shEvenCount(opt_.order);
+        const int J = opt_.grid.count();
+        auto c = std::make_unique<Compression>();
+        c->h = shBandFilter(opt_.order, opt_.filterWidth);
+        c->band = evenBands(opt_.order);
+        if (opt_.fit == Fit::Weighted) {
+            c->fitter = std::make_unique<WeightedFitter>(opt_.grid, opt_.order, opt_.weighting);
+        } else {
+            Eigen::MatrixXd Md = opt_.fit == Fit::LeastSquares
+                                     ? leastSquaresMatrix(opt_.grid, opt_.order)
+                                     : compressionMatrixCached(opt_.grid, opt_.order, opt_.cacheDir);
+            for (int k = 0; k < K; ++k) Md.row(k) *= c->h[c->band[k]];
+            c->Mt = Md.transpose().cast<float>();
+        }
+        c->dirs.resize(J);
+        for (int j = 0; j < J; ++j) c->dirs[j] = glm::vec3(opt_.grid.direction(j));
+        c->order = packetOrder(opt_.grid.nTheta, opt_.grid.nPhi);
+        compression_ = std::move(c);
+        tracer_ = std::make_unique<Tracer>(scene_, opt_.trace);
+    });
+}
+
+SliceResult BakePlan::bakeSlice(size_t beginBatch, size_t endBatch, const SliceProgress& base) const {
+    prepareTracing();
+    const auto t0 = Clock::now();
+    std::unique_ptr<tbb::global_control> threads;
+    if (opt_.threads > 0)
+        threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                        opt_.threads);
+    const BakeOptions& opt = opt_;
+    const SurfaceLayout& L = layout_;
+    const Tracer& tracer = *tracer_;
+    const Compression& compression = *compression_;
+    const Eigen::MatrixXf& Mt = compression.Mt;
+    const std::vector<glm::vec3>& dirs = compression.dirs;
+    const std::vector<uint32_t>& order = compression.order;
+    const bool weighted = compression.fitter != nullptr;
     const size_t n = L.position.size();
     const int K = shEvenCount(opt.order);
     const int J = opt.grid.count();
+    endBatch = std::min(endBatch, batchCount());
+    beginBatch = std::min(beginBatch, endBatch);
 
-    // W = M R: the compression matrix in float for the GEMM, with the band filter folded into
-    // its rows (filtering the weights equals filtering M's rows: diag(h) (M R) = (diag(h) M) R).
-    // The weighted fit solves per sample; the others are one matrix for every sample.
-    const bool weighted = opt.fit == Fit::Weighted;
-    std::unique_ptr<WeightedFitter> fitter;
-    Eigen::MatrixXf Mt;
-    std::vector<double> h = shBandFilter(opt.order, opt.filterWidth);
-    std::vector<int> band = evenBands(opt.order);
-    if (weighted) {
-        fitter = std::make_unique<WeightedFitter>(opt.grid, opt.order, opt.weighting);
-    } else {
-        Eigen::MatrixXd Md = opt.fit == Fit::LeastSquares
-                                 ? leastSquaresMatrix(opt.grid, opt.order)
-                                 : compressionMatrixCached(opt.grid, opt.order, opt.cacheDir);
-        for (int k = 0; k < K; ++k) Md.row(k) *= h[band[k]];
-        // Stored transposed: the GEMM then yields W^T, whose column k (coefficient k of every
-        // sample in the batch, x y z len interleaved) is one contiguous copy into the weights.
-        Mt = Md.transpose().cast<float>();
-    }
-
-    std::vector<glm::vec3> dirs(J);
-    for (int j = 0; j < J; ++j) dirs[j] = glm::vec3(opt.grid.direction(j));
-
-    data.weights.assign(size_t(K) * n * 4, 0.0f);
-    Tracer tracer(scene, opt.trace);
+    SliceResult out;
+    out.first = std::min(beginBatch * kBakeBatch, n);
+    out.count = std::min(endBatch * kBakeBatch, n) - out.first;
+    out.weights.assign(size_t(K) * out.count * 4, 0.0f);
+    const size_t first = out.first, count = out.count;
 
     std::atomic<size_t> done{0}, rays{0};
     std::atomic<size_t> tir{0}, capped{0}, soft{0}, reent{0}, geo{0}, leaked{0};
     std::atomic<int64_t> traceNs{0}, compressNs{0};
     std::mutex progressMutex;
     auto lastReport = Clock::now();
-    const size_t batches = (n + kBatch - 1) / kBatch;
 
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, batches, 1), [&](const tbb::blocked_range<size_t>& range) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(beginBatch, endBatch, 1), [&](const tbb::blocked_range<size_t>& range) {
         enableFlushToZero();
-        Eigen::MatrixXf R(J, 4 * kBatch), Wt(4 * kBatch, K), W(K, 4);
-        std::vector<PathResult> paths(weighted ? size_t(J) * kBatch : 0);
+        Eigen::MatrixXf R(J, 4 * kBakeBatch), Wt(4 * kBakeBatch, K), W(K, 4);
+        std::vector<glm::vec3> omegas(J);
+        std::vector<PathResult> paths(J);
+        std::vector<PathResult> batchPaths(weighted ? size_t(J) * kBakeBatch : 0);  // [s * J + j]
         std::vector<float> confidence(weighted ? J : 0);
         for (size_t b = range.begin(); b != range.end(); ++b) {
             if (opt.cancel && opt.cancel->load()) return;
-            const size_t first = b * kBatch, count = std::min<size_t>(kBatch, n - first);
+            const size_t batchFirst = b * kBakeBatch;
+            const size_t batchCount = std::min<size_t>(kBakeBatch, n - batchFirst);
+            // 1. Trace the batch: R holds every sample's exits and lengths, one column each.
             auto tTrace = Clock::now();
             size_t localRays = 0, ntir = 0, ncap = 0, nsoft = 0, nre = 0, ngeo = 0, nleak = 0;
             R.setZero();
-            for (size_t s = 0; s < count; ++s) {
-                const size_t i = first + s;
+            for (size_t s = 0; s < batchCount; ++s) {
+                const size_t i = batchFirst + s;
                 const Frame frame = Frame::fromNormal(L.normal[i]);
-                for (int j = 0; j < J; ++j) {
-                    const glm::vec3 omega = frame.fromLocal(dirs[j]);
-                    PathResult p = tracer.trace(L.position[i], L.normal[i], omega, L.part[i]);
-                    if (weighted) paths[s * J + j] = p;
+                // Directions in packet order: paths[q] is direction order[q]'s.
+                for (int q = 0; q < J; ++q) omegas[q] = frame.fromLocal(dirs[order[q]]);
+                if (opt.coherent) {
+                    tracer.traceCoherent(L.position[i], L.normal[i], omegas.data(), J, L.part[i], paths.data());
+                } else {
+                    for (int q = 0; q < J; ++q) paths[q] = tracer.trace(L.position[i], L.normal[i], omegas[q], L.part[i]);
+                }
+                if (opt.footprintSamples > 1)
+                    localRays += averageOverFootprint(tracer, L, i, opt.footprintSamples, opt.coherent, omegas, paths);
+                for (int q = 0; q < J; ++q) {
+                    const PathResult& p = paths[q];
+                    const int j = int(order[q]);
+                    if (weighted) batchPaths[s * J + j] = p;
                     R(j, 4 * s + 0) = p.exit.x;
                     R(j, 4 * s + 1) = p.exit.y;
                     R(j, 4 * s + 2) = p.exit.z;
@@ -143,31 +257,35 @@ BakeResult bake(const Scene& scene, const BakeOptions& opt, const std::string& i
                     nleak += (p.flags & kPathLeaked) != 0;
                 }
             }
+            // 2. Compress the batch: the projection W = M R, one GEMM; or one weighted solve per
+            // sample, the band filter applied to its weights.
             auto tGemm = Clock::now();
             if (weighted) {
-                // One solve per sample, the band filter applied to its weights.
-                for (size_t s = 0; s < count; ++s) {
-                    fitter->confidence(&paths[s * J], confidence.data());
-                    fitter->fit(R.middleCols(4 * s, 4), confidence.data(), W);
-                    for (int k = 0; k < K; ++k) W.row(k) *= float(h[band[k]]);
+                for (size_t s = 0; s < batchCount; ++s) {
+                    compression.fitter->confidence(&batchPaths[s * J], confidence.data());
+                    compression.fitter->fit(R.middleCols(4 * s, 4), confidence.data(), W);
+                    for (int k = 0; k < K; ++k) W.row(k) *= float(compression.h[compression.band[k]]);
                     Wt.middleRows(4 * s, 4) = W.transpose();
                 }
             } else {
-                Wt.noalias() = R.transpose() * Mt;  // the projection W = M R: one GEMM per batch
+                Wt.noalias() = R.transpose() * Mt;
             }
+            // 3. Store its weights.
             for (int k = 0; k < K; ++k)
-                std::copy_n(Wt.col(k).data(), 4 * count, &data.weights[(size_t(k) * n + first) * 4]);
+                std::copy_n(Wt.col(k).data(), 4 * batchCount,
+                            &out.weights[(size_t(k) * count + batchFirst - first) * 4]);
             auto tEnd = Clock::now();
             traceNs += std::chrono::duration_cast<std::chrono::nanoseconds>(tGemm - tTrace).count();
             compressNs += std::chrono::duration_cast<std::chrono::nanoseconds>(tEnd - tGemm).count();
             rays += localRays, tir += ntir, capped += ncap, soft += nsoft, reent += nre;
             geo += ngeo, leaked += nleak;
-            size_t nowDone = done += count;
+            size_t nowDone = done += batchCount;
             if (opt.progress && progressMutex.try_lock()) {
                 std::lock_guard<std::mutex> g(progressMutex, std::adopt_lock);
-                if (secondsSince(lastReport) > 0.2 || nowDone == n) {
+                if (secondsSince(lastReport) > 0.2 || nowDone == count) {
                     lastReport = Clock::now();
-                    opt.progress(BakeProgress{nowDone, n, rays.load(), secondsSince(t0)});
+                    opt.progress(BakeProgress{base.samplesDone + nowDone, n, base.samplesResumed,
+                                              base.rays + rays.load(), base.seconds + secondsSince(t0)});
                 }
             }
         }
@@ -175,20 +293,23 @@ BakeResult bake(const Scene& scene, const BakeOptions& opt, const std::string& i
     if (opt.cancel && opt.cancel->load()) throw Cancelled();
 
     BakeStats& st = out.stats;
-    st.samples = n;
-    st.paths = n * size_t(J);
+    st.samples = count;
+    st.paths = count * size_t(J);
     st.rays = rays, st.tir = tir, st.capped = capped, st.softCapped = soft;
     st.reentered = reent, st.geometricNormal = geo, st.leaked = leaked;
     st.traceSeconds = traceNs * 1e-9, st.compressSeconds = compressNs * 1e-9;
     st.wallSeconds = secondsSince(t0);
-    st.rhoOverhead = rhoOverhead(L);
-    nlohmann::json layoutInfo = {{"kind", ToString(L.kind)}};
-    if (L.isChartLayout()) {
-        const ChartStats& c = st.charts;
-        layoutInfo["method"] = L.kind == LayoutKind::Isolated ? ToString(opt.charts.method) : "mesh uv";
+    return out;
+}
+
+nlohmann::json BakePlan::manifest(const BakeStats& stats) const {
+    nlohmann::json layoutInfo = {{"kind", ToString(layout_.kind)}};
+    if (layout_.isChartLayout()) {
+        const ChartStats& c = charts_;
+        layoutInfo["method"] = layout_.kind == LayoutKind::Isolated ? ToString(opt_.charts.method) : "mesh uv";
         layoutInfo["seamMesh"] = c.seamMesh;
-        layoutInfo["coneDegrees"] = opt.charts.coneDegrees;
-        layoutInfo["maxDensityRatio"] = opt.charts.maxDensityRatio;
+        layoutInfo["coneDegrees"] = opt_.charts.coneDegrees;
+        layoutInfo["maxDensityRatio"] = opt_.charts.maxDensityRatio;
         layoutInfo["splits"] = c.splits;
         layoutInfo["arapCharts"] = c.arapCharts;
         layoutInfo["texelsPerObjectUnit"] = c.texelsPerObjectUnit;
@@ -199,39 +320,72 @@ BakeResult bake(const Scene& scene, const BakeOptions& opt, const std::string& i
         layoutInfo["borderEdges"] = c.borderEdges;
         layoutInfo["gutterTexels"] = c.gutterTexels;
     }
-
+    // Paths absolute, so that the same bake run from another folder (a scheduler's job, a
+    // merge) describes itself the same way.
+    auto absolute = [](const std::string& path) {
+        std::error_code ec;
+        auto abs = std::filesystem::absolute(path, ec);
+        return ec ? path : abs.lexically_normal().string();
+    };
     nlohmann::json media = nlohmann::json::array();
-    std::vector<std::string> checksums;
-    for (const Part& p : scene.parts) {
+    for (const Part& p : scene_.parts) {
         media.push_back({{"name", p.medium.name},
-                         {"mesh", p.meshPath},
+                         {"mesh", absolute(p.meshPath)},
                          {"ior", p.medium.ior},
                          {"absorption", {p.medium.absorption.x, p.medium.absorption.y, p.medium.absorption.z}},
                          {"priority", p.medium.priority},
                          {"meshChecksum", p.mesh.checksum()},
                          {"triangles", p.mesh.triangles.size()}});
     }
-    std::error_code ec;
-    auto abs = std::filesystem::absolute(inputPath, ec);
-    data.manifest = {
-        {"input", ec ? inputPath : abs.string()},
-        {"grid", {opt.grid.nTheta, opt.grid.nPhi}},
-        {"filterWidth", opt.filterWidth},
-        {"fit", ToString(opt.fit)},
-        {"fitWeighting", weighted ? opt.weighting.ToString() : ""},
-        {"branch", opt.trace.branch == Branch::Fresnel ? "fresnel" : "transmit"},
-        {"maxBounces", opt.trace.maxBounces},
+    return {
+        {"input", absolute(input_)},
+        {"grid", {opt_.grid.nTheta, opt_.grid.nPhi}},
+        {"filterWidth", opt_.filterWidth},
+        {"fit", ToString(opt_.fit)},
+        {"fitWeighting", opt_.fit == Fit::Weighted ? opt_.weighting.ToString() : ""},
+        {"footprintSamples", opt_.footprintSamples},
+        {"branch", opt_.trace.branch == Branch::Fresnel ? "fresnel" : "transmit"},
+        {"maxBounces", opt_.trace.maxBounces},
+        {"tracer", opt_.coherent ? "coherent" : "scalar"},
         {"media", media},
         {"sh", {{"convention", "real, orthonormal, no Condon-Shortley phase (docs/conventions.md)"},
                 {"stored", "l+m even, even order: l = 0..L, m = -l, -l+2, ..., l"},
                 {"channels", "exit x, y, z (object space), path length"}}},
         {"frame", "Duff et al. 2017 orthonormal basis from the shading normal, z = normal"},
         {"layout", layoutInfo},
-        {"stats", {{"paths", st.paths}, {"rays", st.rays}, {"tir", st.tir}, {"capped", st.capped},
-                   {"softCapped", st.softCapped}, {"reentered", st.reentered},
-                   {"geometricNormal", st.geometricNormal}, {"leaked", st.leaked},
-                   {"seconds", st.wallSeconds}}},
+        {"stats", stats.ToJson()},
     };
+}
+
+BakeData BakePlan::data(std::vector<float> weights, const BakeStats& stats) const {
+    BakeData d;
+    d.order = opt_.order;
+    d.precision = opt_.precision;
+    d.layout = layout_;
+    d.weights = std::move(weights);
+    d.manifest = manifest(stats);
+    return d;
+}
+
+std::string BakePlan::layoutChecksum() const {
+    Checksum sum;
+    const size_t n = layout_.position.size();
+    sum.update(layout_.position.data(), n * sizeof(glm::vec3));
+    sum.update(layout_.normal.data(), n * sizeof(glm::vec3));
+    sum.update(layout_.part.data(), n * sizeof(uint32_t));
+    return sum.hex();
+}
+
+BakeResult bake(const Scene& scene, const BakeOptions& opt, const std::string& inputPath) {
+    const auto t0 = Clock::now();
+    BakePlan plan(scene, opt, inputPath);
+    SliceResult all = plan.bakeSlice(0, plan.batchCount());
+    BakeResult out;
+    out.stats = all.stats;
+    out.stats.wallSeconds = secondsSince(t0);
+    out.stats.rhoOverhead = rhoOverhead(plan.layout());
+    out.stats.charts = plan.chartStats();
+    out.data = plan.data(std::move(all.weights), out.stats);
     return out;
 }
 

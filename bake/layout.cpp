@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "common/error.h"
+#include "common/limits.h"
 
 namespace shrefract {
 namespace {
@@ -49,12 +50,12 @@ size_t joiningSampleCount(const Scene& scene, int rate) {
 
 int rateForSampleCount(const Scene& scene, size_t target) {
     Topology tp = topology(scene);
-    for (int r = 1; r < 256; ++r) {
+    for (int r = 1; r < limits::kMaxRate; ++r) {
         size_t rr = r;
         size_t n = tp.vertices + tp.edges * (rr - 1) + tp.triangles * (rr - 1) * (rr >= 2 ? rr - 2 : 0) / 2;
         if (n >= target) return r;
     }
-    return 256;
+    return limits::kMaxRate;
 }
 
 SurfaceLayout buildJoiningLayout(const Scene& scene, int rate) {

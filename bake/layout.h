@@ -12,7 +12,8 @@ namespace shrefract {
 
 // Unique samples of a scene at rate r: vertices + (r-1) per edge + (r-1)(r-2)/2 per triangle.
 size_t joiningSampleCount(const Scene& scene, int rate);
-// The smallest rate whose unique sample count reaches `target` (at least 1).
+// The smallest rate whose unique sample count reaches `target` (at least 1, at most
+// limits::kMaxRate).
 int rateForSampleCount(const Scene& scene, size_t target);
 // Builds mu, rho and the smoothing neighbour lists for all parts of the scene.
 SurfaceLayout buildJoiningLayout(const Scene& scene, int rate);

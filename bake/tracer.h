@@ -64,8 +64,17 @@ public:
     // The path entering part `part` at surface point `p` with outward shading normal `n`, along
     // the object-space direction `-omega` (omega points toward the viewer, n . omega > 0).
     // Rule 1: the first interface always transmits.
+    // The scalar tracer: one rtcIntersect1 per segment. The reference traceCoherent is tested
+    // against.
     PathResult trace(glm::vec3 p, glm::vec3 n, glm::vec3 omega, uint32_t part,
                      std::vector<LoggedRay>* log = nullptr) const;
+    // The paths of one sample for `count` directions omegas[j] (object space), by the same rules
+    // as trace(), traced path step by path step: segment k of every path still active goes to
+    // Embree as one stream, the first (shared origin) as coherent packets of 16 consecutive
+    // directions (give them in packetOrder), the later ones ray by ray, their triangles fetched
+    // ahead. out[j] is omegas[j]'s path. The same exits as trace() to float tolerance.
+    void traceCoherent(glm::vec3 p, glm::vec3 n, const glm::vec3* omegas, size_t count,
+                       uint32_t part, PathResult* out) const;
 
     // A bare closest-hit query, nothing else: the ceiling the benchmark compares against.
     bool intersect(glm::vec3 org, glm::vec3 dir, float* t) const;
@@ -78,12 +87,19 @@ public:
 
 private:
     struct Embree;
+    struct Path;  // one path in flight
+    bool start(glm::vec3 p, glm::vec3 n, glm::vec3 omega, uint32_t part, Path* path) const;
+    bool advance(Path* path, const ::RTCRayHit& rh) const;
     SurfaceHit surfaceAt(const ::RTCRayHit& rh) const;
     const Scene& scene_;
     TraceOptions options_;
     std::unique_ptr<Embree> rtc_;
     float epsilon_ = 1e-5f;
 };
+
+// The grid directions (index i * nPhi + k) in 4 x 4 tiles of (theta, phi): the order in which
+// traceCoherent's 16-ray packets are compact cones.
+std::vector<uint32_t> packetOrder(int nTheta, int nPhi);
 
 // Sets flush-to-zero and denormals-are-zero on the calling thread (every tracing thread).
 void enableFlushToZero();

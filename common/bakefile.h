@@ -142,12 +142,30 @@ struct ReadOptions {
     bool verify = true;
 };
 
-// Writes to a temporary name beside `path` and renames it when complete: on any failure nothing
-// is left and an existing file at `path` is untouched. Quantizes to `data.precision`.
+// Writes to a temporary file beside `path` and renames it when complete (writeAtomically,
+// common/output.h): on any failure nothing is left and an existing file at `path` is untouched;
+// a refused target (missing folder, symbolic link, FIFO, device) is an InputError, a failed
+// write an IoError with the OS's reason. Quantizes to `data.precision`.
 void writeBake(const std::string& path, const BakeData& data);
 // Reads and validates; throws InputError naming the file and the problem (missing, not a
 // shrefract bake, newer format version than kFormatVersion, a part or the manifest that does not
 // match its checksum, inconsistent sizes).
 BakeData readBake(const std::string& path, const ReadOptions& options = {});
+
+// A shard (docs/format.md "Shards"): the float32 weights of one slice of a bake's samples and a
+// manifest that names the whole bake and the slice. `shrefract-bake --shard` and checkpoints
+// write them; shrefract-merge (bake/shard.h) assembles a bake's shards into its bake file.
+struct ShardData {
+    nlohmann::json manifest;    // must hold a "shard" object; the writer adds the format keys
+    int order = 8;              // L
+    size_t sampleCount = 0;     // samples in this slice
+    std::vector<float> weights; // [(k * sampleCount + i) * 4 + c], as BakeData::weights
+};
+
+// Writes a shard all or nothing, as writeBake does (uncompressed: float weights hardly compress).
+void writeShard(const std::string& path, const ShardData& shard);
+// Reads a shard and verifies it against its checksums (the manifest only when `weights` is
+// false); throws InputError naming the file: not found, not a shard, corrupt, truncated.
+ShardData readShard(const std::string& path, bool weights = true);
 
 }  // namespace shrefract

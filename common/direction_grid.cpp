@@ -17,6 +17,8 @@
 #include <vector>
 
 #include "common/error.h"
+#include "common/limits.h"
+#include "common/output.h"
 #include "common/sh.h"
 
 namespace shrefract {
@@ -99,13 +101,11 @@ bool readCache(const std::string& path, const DirectionGrid& g, int L, int q, Ei
     return true;
 }
 
-// Writes to a unique temporary name in the same directory, then renames: readers never see a
-// half-written file, and concurrent writers of the same matrix just race to identical content.
+// Writes through writeAtomically (common/output.h): readers never see a half-written file, a
+// killed bake leaves no temporary, and concurrent writers of the same matrix just race to
+// identical content. A cache that cannot be written is no error: returns false.
 bool writeCache(const std::string& path, const DirectionGrid& g, int L, int q,
                 const Eigen::MatrixXd& M) {
-    static std::atomic<int> counter{0};
-    std::string tmp =
-        path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter.fetch_add(1));
     CacheHeader h;
     std::memcpy(h.magic, kCacheMagic, 8);
     h.L = L;
@@ -115,21 +115,14 @@ bool writeCache(const std::string& path, const DirectionGrid& g, int L, int q,
     h.rows = M.rows();
     h.cols = M.cols();
     h.checksum = fnv1a(M.data(), size_t(M.size()) * sizeof(double));
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        out.write(reinterpret_cast<const char*>(&h), sizeof h);
-        out.write(reinterpret_cast<const char*>(M.data()),
-                  std::streamsize(M.size() * sizeof(double)));
-        if (!out.good()) {
-            out.close();
-            std::remove(tmp.c_str());
-            return false;
-        }
+    std::string bytes(reinterpret_cast<const char*>(&h), sizeof h);
+    bytes.append(reinterpret_cast<const char*>(M.data()), size_t(M.size()) * sizeof(double));
+    try {
+        writeFile(path, bytes);
+        return true;
+    } catch (const std::exception&) {
+        return false;
     }
-    std::error_code ec;
-    std::filesystem::rename(tmp, path, ec);
-    if (ec) std::remove(tmp.c_str());
-    return !ec;
 }
 
 }  // namespace
@@ -231,10 +224,18 @@ DirectionGrid parseGrid(const std::string& text, const std::string& what) {
     DirectionGrid g;
     g.nTheta = std::stoi(text.substr(0, x));
     g.nPhi = std::stoi(text.substr(x + 1));
-    if (g.nTheta < 2 || g.nTheta > 1024 || g.nPhi < 2 || g.nPhi > 1024)
-        throw bad("counts must lie in [2, 1024]");
-    if (g.nPhi % 2 != 0) throw bad("NPHI must be even (the pole reflection maps phi to phi + pi)");
+    const std::string problem = gridProblem(g.nTheta, g.nPhi);
+    if (!problem.empty()) throw bad(problem);
     return g;
+}
+
+std::string gridProblem(int nTheta, int nPhi) {
+    if (nTheta < limits::kMinGrid || nTheta > limits::kMaxGrid || nPhi < limits::kMinGrid ||
+        nPhi > limits::kMaxGrid)
+        return "counts must lie in [" + std::to_string(limits::kMinGrid) + ", " +
+               std::to_string(limits::kMaxGrid) + "]";
+    if (nPhi % 2 != 0) return "NPHI must be even (the pole reflection maps phi to phi + pi)";
+    return "";
 }
 
 Eigen::MatrixXd compressionMatrix(const DirectionGrid& grid, int L, int q) {

@@ -28,6 +28,9 @@ struct DirectionGrid {
     int interpolate(glm::dvec3 w, int index[4], double weight[4]) const;
     std::string ToString() const;  // "32x64"
 };
+// What is wrong with a grid, or "" when it is usable: counts in [limits::kMinGrid, kMaxGrid], nPhi
+// even. The one check for --grid and for a bake file's manifest.
+std::string gridProblem(int nTheta, int nPhi);
 // Parses "32x64"; throws InputError naming `what` on bad text.
 DirectionGrid parseGrid(const std::string& text, const std::string& what = "--grid");
 

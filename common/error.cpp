@@ -2,6 +2,15 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+
+namespace shrefract {
+
+IoError ioError(const std::string& file, const std::string& what, int err) {
+    return IoError(file + ": " + what + ": " + (err != 0 ? std::strerror(err) : "unknown error"));
+}
+
+}  // namespace shrefract
 
 namespace shrefract::detail {
 

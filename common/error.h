@@ -18,6 +18,22 @@ inline InputError inputError(const std::string& file, const std::string& problem
     return InputError(file + ": " + problem);
 }
 
+// The operating system refused a read or write that the input could not have foreseen (disk
+// full, permission denied, I/O error): not bad input, so the tools exit 1, not 2. The message
+// names the file and gives the OS's reason.
+struct IoError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+// "FILE: what: strerror(err)" (errno err, as the failing call left it).
+IoError ioError(const std::string& file, const std::string& what, int err);
+
+// The user asked to stop (Ctrl-C, SIGTERM): work is abandoned, nothing is written, the tools
+// exit 130.
+struct Cancelled : std::runtime_error {
+    Cancelled() : std::runtime_error("cancelled") {}
+};
+
 }  // namespace shrefract
 
 // A broken invariant is a bug in shrefract, not in the input: print both sides and abort.

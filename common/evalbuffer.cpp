@@ -11,6 +11,9 @@
 #include <ImfOutputFile.h>
 
 #include "common/error.h"
+#include "common/exr_input.h"
+#include "common/exr_output.h"
+#include "common/output.h"
 
 namespace shrefract {
 
@@ -52,32 +55,28 @@ EvalBuffer makeEvalBuffer(int width, int height, const std::vector<float>& color
 void writeEvalBuffer(const std::string& path, const EvalBuffer& buffer) {
     SHREFRACT_CHECK(buffer.color.size() == buffer.pixelCount() &&
                     buffer.direction.size() == buffer.pixelCount());
-    const std::string tmp = path + ".tmp";
-    try {
-        EvalBuffer& b = const_cast<EvalBuffer&>(buffer);  // OpenEXR slices take char*; only read
-        Imf::Header header(b.width, b.height);
-        header.compression() = Imf::ZIP_COMPRESSION;
-        header.insert("shrefractEval", Imf::IntAttribute(1));
-        Imf::FrameBuffer fb;
-        for (int c = 0; c < 7; ++c) {
-            header.channels().insert(kChannels[c], Imf::Channel(Imf::FLOAT));
-            fb.insert(kChannels[c], sliceOf(b, c));
-        }
-        {
-            Imf::OutputFile file(tmp.c_str(), header);
+    EvalBuffer& b = const_cast<EvalBuffer&>(buffer);  // OpenEXR slices take char*; only read
+    Imf::Header header(b.width, b.height);
+    header.compression() = Imf::ZIP_COMPRESSION;
+    header.insert("shrefractEval", Imf::IntAttribute(1));
+    Imf::FrameBuffer fb;
+    for (int c = 0; c < 7; ++c) {
+        header.channels().insert(kChannels[c], Imf::Channel(Imf::FLOAT));
+        fb.insert(kChannels[c], sliceOf(b, c));
+    }
+    writeAtomically(path, [&](const std::string& staged) {
+        writeExrFile(staged, [&](Imf::OStream& stream) {
+            Imf::OutputFile file(stream, header);
             file.setFrameBuffer(fb);
             file.writePixels(b.height);
-        }
-        std::filesystem::rename(tmp, path);
-    } catch (const std::exception& e) {
-        std::error_code ec;
-        std::filesystem::remove(tmp, ec);
-        throw inputError(path, std::string("cannot write: ") + e.what());
-    }
+        });
+    });
 }
 
 EvalBuffer readEvalBuffer(const std::string& path) {
     EvalBuffer b;
+    if (!std::filesystem::is_regular_file(path)) throw inputError(path, "file not found");
+    checkExrHeaders(path);  // before OpenEXR allocates what a damaged header claims
     try {
         Imf::InputFile file(path.c_str());
         const Imath::Box2i dw = file.header().dataWindow();

@@ -27,7 +27,8 @@ EvalBuffer makeEvalBuffer(int width, int height, const std::vector<float>& color
                           const std::vector<float>& directionRgba);
 
 // Channels R, G, B, A (FLOAT), dir.X, dir.Y, dir.Z (FLOAT); ZIP; attribute "shrefractEval" = 1.
-// Written to a temporary name and renamed; throws InputError naming the file.
+// Written through writeAtomically (common/output.h): InputError for a refused target, IoError
+// with the OS's reason for a failed write; either leaves `path` as it was.
 void writeEvalBuffer(const std::string& path, const EvalBuffer& buffer);
 // Reads that layout; a file without the dir.* channels is an InputError.
 EvalBuffer readEvalBuffer(const std::string& path);

@@ -21,11 +21,8 @@
 #include <ImfMultiPartOutputFile.h>
 #include <ImfOutputPart.h>
 #include <ImfPartType.h>
-#include <ImfStdIO.h>
 #include <ImfStringAttribute.h>
-#include <fcntl.h>
 #include <half.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -42,7 +39,13 @@
 
 #include "common/bakefile.h"
 #include "common/checksum.h"
+#include "common/direction_grid.h"
 #include "common/error.h"
+#include "common/exr_input.h"
+#include "common/exr_output.h"
+#include "common/limits.h"
+#include "common/output.h"
+#include "common/scene.h"
 #include "common/sh.h"
 
 namespace shrefract {
@@ -182,6 +185,10 @@ std::vector<Channel> weightChannels(int K, Precision p) {
         }
     }
     return ch;
+}
+// Bytes of one weights texel: 16 per coefficient in f32, 8 in f16, 4 in u8.
+uint64_t weightsTexelBytes(int K, Precision p) {
+    return uint64_t(K) * (p == Precision::U8 ? 4 : p == Precision::F16 ? 8 : 16);
 }
 const std::vector<Channel> kSampleChannels = {
     {"P.x", Imf::FLOAT}, {"P.y", Imf::FLOAT}, {"P.z", Imf::FLOAT}, {"N.x", Imf::FLOAT},
@@ -337,7 +344,8 @@ std::string chartInconsistency(const SurfaceLayout& L) {
 
 std::string inconsistency(const BakeData& d) {
     const SurfaceLayout& L = d.layout;
-    if (d.order < 0) return str("order ", d.order, " is negative");
+    if (d.order < 0 || d.order > limits::kMaxOrder)
+        return str("SH order ", d.order, " is not in [0, ", limits::kMaxOrder, "]");
     const size_t K = size_t(d.coefficientCount());
     const size_t N = L.position.size();
     if (L.normal.size() != N || L.part.size() != N)
@@ -354,9 +362,12 @@ std::string inconsistency(const BakeData& d) {
     if (L.isChartLayout()) {
         const std::string chart = chartInconsistency(L);
         if (!chart.empty()) return chart;
-    } else if (L.rate < 1) {
-        return str("rate ", L.rate, " is below 1");
+    } else if (L.rate < 1 || L.rate > limits::kMaxRate) {
+        return str("rate ", L.rate, " is not in [1, ", limits::kMaxRate, "]");
     }
+    for (int side : {L.muWidth, L.muHeight, L.rhoWidth, L.rhoHeight})
+        if (side > limits::kMaxTextureSize)
+            return str("a layout side of ", side, " texels is above ", limits::kMaxTextureSize);
     if (L.triangleCount < 0) return str("triangle count ", L.triangleCount, " is negative");
     if (L.triangleCount > 0 && !L.isChartLayout()) {
         if (L.blockWidth < 1 || L.blockHeight < 1 || L.blocksPerRow < 1)
@@ -369,6 +380,13 @@ std::string inconsistency(const BakeData& d) {
             return str(L.triangleCount, " triangles in ", L.blockWidth, " x ", L.blockHeight,
                        " blocks, ", L.blocksPerRow, " per row, do not fit the ", L.rhoWidth, " x ",
                        L.rhoHeight, " rho layout");
+        // A block holds an upright triangle's samples (i + j <= r) and corrections (r + 1), and
+        // its rotated partner's, without the two meeting (docs/format.md "rho").
+        const int r = L.rate;
+        if (L.blockWidth < r + 1 || L.blockHeight < r + 1 || L.blockWidth + L.blockHeight < 2 * r + 5)
+            return str("rho blocks of ", L.blockWidth, " x ", L.blockHeight,
+                       " texels cannot hold two triangles at rate ", r);
+        if (N == 0) return str(L.triangleCount, " triangles but no samples");
     }
     for (size_t t = 0; t < L.rho.size(); ++t) {
         const RhoTexel& r = L.rho[t];
@@ -380,6 +398,29 @@ std::string inconsistency(const BakeData& d) {
         if (bad)
             return str("rho texel (", x, ", ", y, ") refers to samples (", r.a, ", ", r.b, ", ",
                        r.c, ") but there are only ", N);
+    }
+    // Every triangle's grid positions hold its samples, and the texels past its hypotenuse its
+    // corrections: what the runtime and queryBake look up (SurfaceLayout::sampleAt).
+    for (int t = 0; t < L.triangleCount; ++t) {
+        for (int j = 0; j <= L.rate + 1; ++j)
+            for (int i = 0; i + j <= L.rate + 1; ++i) {
+                const bool correction = i + j == L.rate + 1;
+                if (correction && (i == 0 || j == 0)) continue;
+                const glm::ivec2 x = L.rhoTexel(t, i, j);
+                const uint32_t kind = L.rho[size_t(x.y) * size_t(L.rhoWidth) + size_t(x.x)].kind;
+                if (kind != (correction ? RhoTexel::Correction : RhoTexel::Sample))
+                    return str("triangle ", t, "'s ", correction ? "correction" : "sample",
+                               " texel (", i, ", ", j, ") at rho (", x.x, ", ", x.y,
+                               ") has kind ", kind);
+            }
+    }
+    for (size_t i = 0; i < N; ++i) {
+        const glm::vec3 p = L.position[i], n = L.normal[i];
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+            return str("sample ", i, " has a non-finite position");
+        const float len = glm::length(n);
+        if (!(std::fabs(len - 1.0f) < 1e-3f))
+            return str("sample ", i, " has a normal of length ", len, ", not a unit vector");
     }
     if (L.neighbourOffset.size() != N || L.neighbourCount.size() != N)
         return str("neighbour offsets (", L.neighbourOffset.size(), ") and counts (",
@@ -396,10 +437,27 @@ std::string inconsistency(const BakeData& d) {
         if (L.neighbourIndex[e] >= N)
             return str("neighbour list entry ", e, " refers to sample ", L.neighbourIndex[e],
                        " but there are only ", N);
+        if (!std::isfinite(L.neighbourWeight[e]))
+            return str("neighbour list entry ", e, " has a non-finite weight");
+    }
+    // Smoothing averages a sample with its neighbours: itself first, weights summing to 1.
+    for (size_t i = 0; i < N; ++i) {
+        if (L.neighbourCount[i] == 0) continue;
+        if (L.neighbourIndex[L.neighbourOffset[i]] != i)
+            return str("the neighbour list of sample ", i, " does not start with the sample itself");
+        double sum = 0;
+        for (uint32_t k = 0; k < L.neighbourCount[i]; ++k)
+            sum += L.neighbourWeight[L.neighbourOffset[i] + k];
+        if (!(std::fabs(sum - 1.0) < 1e-3))
+            return str("the neighbour weights of sample ", i, " sum to ", sum, ", not 1");
     }
     if (d.weights.size() != K * N * 4)
         return str(d.weights.size(), " weights, expected ", K, " coefficients x ", N,
                    " samples x 4");
+    for (size_t v = 0; v < d.weights.size(); ++v)
+        if (!std::isfinite(d.weights[v]))
+            return str("weight ", v / (4 * N), " of sample ", (v / 4) % N, " channel ",
+                       kWeightSuffix[v % 4], " is not finite");
     return "";
 }
 
@@ -416,12 +474,13 @@ std::pair<int, int> neighbourListSize(size_t E) {
 // Writing.
 
 Imf::Header partHeader(const char* name, int width, int height, const Imath::Box2i& display,
-                       const std::string& manifest) {
+                       const std::string& manifest,
+                       Imf::Compression compression = Imf::ZIP_COMPRESSION) {
     Imf::Header h(width, height);
     h.displayWindow() = display;  // shared by all parts of a multi-part file
     h.setName(name);
     h.setType(Imf::SCANLINEIMAGE);
-    h.compression() = Imf::ZIP_COMPRESSION;
+    h.compression() = compression;
     h.insert(kManifestAttribute, Imf::StringAttribute(manifest));
     h.insert(kManifestChecksumAttribute, Imf::StringAttribute(checksumHex(manifest)));
     return h;
@@ -437,26 +496,40 @@ void writeWhole(Imf::MultiPartOutputFile& file, int part, Planes& planes, int he
     out.writePixels(height);
 }
 
-// The sample at mu texel `texel` (kNoSample: none): `map` for chart layouts (texelSamples), else
+// The sample at texel `texel` (kNoSample: none): `map` for chart layouts (texelSamples), else
 // the texel index itself while below the sample count.
-uint32_t sampleOfTexel(const std::vector<uint32_t>& map, size_t texel, size_t N) {
-    if (!map.empty()) return map[texel];
+uint32_t sampleOfTexel(const uint32_t* map, size_t texel, size_t N) {
+    if (map) return map[texel];
     return texel < N ? uint32_t(texel) : kNoSample;
 }
 
-// Rows y0 .. y0 + rows - 1 of the weights part, quantized to the bake's precision. `map`: the
-// chart layout's texelSamples, empty for joining.
-Planes weightChunk(const BakeData& d, const U8Params& u8, const std::vector<uint32_t>& map,
-                   int y0, int rows) {
-    const SurfaceLayout& L = d.layout;
-    const int K = d.coefficientCount();
-    const size_t N = L.position.size();
-    Planes chunk(L.muWidth, rows, weightChannels(K, d.precision));
-    for (size_t t = 0; t < size_t(L.muWidth) * rows; ++t) {
-        const uint32_t i = sampleOfTexel(map, size_t(y0) * L.muWidth + t, N);
+// The weights of N samples as a part stores them, K coefficients of 4 channels each; in memory
+// weights[(k * N + i) * 4 + c] (BakeData::weights). Sample i sits at texel i (i % width,
+// i / width), or for chart layouts where `map` (texel -> sample, kNoSample for none) puts it.
+struct WeightsPart {
+    const float* data;
+    size_t N;
+    int K;
+    Precision precision;
+    int width, height;
+    const uint32_t* map = nullptr;
+};
+
+WeightsPart weightsPart(const BakeData& d, const std::vector<uint32_t>& map) {
+    return {d.weights.data(), d.layout.position.size(), d.coefficientCount(), d.precision,
+            d.layout.muWidth, d.layout.muHeight, map.empty() ? nullptr : map.data()};
+}
+
+// Rows y0 .. y0 + rows - 1 of the weights part, quantized to its precision.
+Planes weightChunk(const WeightsPart& d, const U8Params& u8, int y0, int rows) {
+    const int K = d.K;
+    const size_t N = d.N;
+    Planes chunk(d.width, rows, weightChannels(K, d.precision));
+    for (size_t t = 0; t < size_t(d.width) * rows; ++t) {
+        const uint32_t i = sampleOfTexel(d.map, size_t(y0) * d.width + t, N);
         if (i == kNoSample) continue;  // texels without a sample stay zero
         for (int k = 0; k < K; ++k) {
-            const float* w = &d.weights[(size_t(k) * N + i) * 4];
+            const float* w = &d.data[(size_t(k) * N + i) * 4];
             if (d.precision == Precision::U8) {
                 uint32_t packed = 0;
                 for (int c = 0; c < 4; ++c)
@@ -480,41 +553,37 @@ Planes weightChunk(const BakeData& d, const U8Params& u8, const std::vector<uint
 }
 
 // The checksum of the whole weights part, chunk by chunk as it will be written.
-std::string weightsChecksum(const BakeData& d, const U8Params& u8, const std::vector<uint32_t>& map) {
+std::string weightsChecksum(const WeightsPart& d, const U8Params& u8) {
     Checksum sum;
-    for (int y0 = 0; y0 < d.layout.muHeight; y0 += kChunkRows) {
-        const Planes chunk =
-            weightChunk(d, u8, map, y0, std::min(kChunkRows, d.layout.muHeight - y0));
+    for (int y0 = 0; y0 < d.height; y0 += kChunkRows) {
+        const Planes chunk = weightChunk(d, u8, y0, std::min(kChunkRows, d.height - y0));
         sum.update(chunk.bytes().data(), chunk.bytes().size());
     }
     return sum.hex();
 }
 
-void writeWeights(Imf::MultiPartOutputFile& file, int part, const BakeData& d, const U8Params& u8,
-                  const std::vector<uint32_t>& map) {
+void writeWeights(Imf::MultiPartOutputFile& file, int part, const WeightsPart& d, const U8Params& u8) {
     Imf::OutputPart out(file, part);
-    for (int y0 = 0; y0 < d.layout.muHeight; y0 += kChunkRows) {
-        const int rows = std::min(kChunkRows, d.layout.muHeight - y0);
-        Planes chunk = weightChunk(d, u8, map, y0, rows);
+    for (int y0 = 0; y0 < d.height; y0 += kChunkRows) {
+        const int rows = std::min(kChunkRows, d.height - y0);
+        Planes chunk = weightChunk(d, u8, y0, rows);
         out.setFrameBuffer(chunk.frameBuffer(y0));
         out.writePixels(rows);
     }
 }
 
-// Flushes the file's data to disk before the rename makes it visible under its final name.
-void syncFile(const std::string& path) {
-    const int fd = ::open(path.c_str(), O_RDONLY);
-    if (fd < 0) return;
-    ::fsync(fd);
-    ::close(fd);
-}
-
 // ---------------------------------------------------------------------------------------------
 // Reading.
 
+bool fitsInt(const json& x) {
+    if (!x.is_number_integer()) return false;
+    if (x.is_number_unsigned()) return x.get<uint64_t>() <= uint64_t(INT32_MAX);
+    return x.get<int64_t>() >= INT32_MIN && x.get<int64_t>() <= INT32_MAX;
+}
+
 int manifestInt(const json& m, const char* key) {
     auto it = m.find(key);
-    if (it == m.end() || !it->is_number_integer())
+    if (it == m.end() || !fitsInt(*it))
         throw InputError(str("manifest has no integer \"", key, "\""));
     return it->get<int>();
 }
@@ -525,7 +594,7 @@ std::vector<int> manifestInts(const json& m, const char* key, size_t n) {
         throw InputError(str("manifest has no \"", key, "\" array of ", n, " integers"));
     std::vector<int> v;
     for (const json& x : *it) {
-        if (!x.is_number_integer())
+        if (!fitsInt(x))
             throw InputError(str("manifest has no \"", key, "\" array of ", n, " integers"));
         v.push_back(x.get<int>());
     }
@@ -542,6 +611,65 @@ std::vector<double> manifestNumbers(const json& m, const char* key, size_t n) {
         v.push_back(x.get<double>());
     }
     return v;
+}
+
+// The descriptive keys that tools act on (evaluation re-traces with the media, grid, branch and
+// bounce cap; the runtime shades with media[0]), checked as shrefract-bake checks its options and
+// a scene its media (common/limits.h, mediumProblem): a manifest that says IOR 0 is refused, not
+// rendered as a mirror. Keys a bake may lack are checked only when present. Returns what is
+// wrong, or "".
+std::string manifestProblem(const json& m) {
+    if (auto it = m.find("media"); it != m.end()) {
+        if (!it->is_array()) return "\"media\" is not an array";
+        for (size_t i = 0; i < it->size(); ++i) {
+            const json& md = (*it)[i];
+            const std::string where = str("media[", i, "]");
+            if (!md.is_object()) return where + " is not an object";
+            Medium medium;
+            if (md.contains("ior")) {
+                if (!md["ior"].is_number()) return where + ": 'ior' is not a number";
+                medium.ior = md["ior"].get<double>();
+            }
+            if (md.contains("absorption")) {
+                const json& a = md["absorption"];
+                if (!a.is_array() || a.size() != 3) return where + ": 'absorption' is not 3 numbers";
+                for (int c = 0; c < 3; ++c) {
+                    if (!a[c].is_number()) return where + ": 'absorption' is not 3 numbers";
+                    medium.absorption[c] = a[c].get<double>();
+                }
+            }
+            if (md.contains("priority") && !md["priority"].is_number_integer())
+                return where + ": 'priority' is not an integer";
+            for (const char* key : {"name", "mesh", "meshChecksum"})
+                if (md.contains(key) && !md[key].is_string())
+                    return str(where, ": '", key, "' is not a string");
+            const std::string problem = mediumProblem(medium);
+            if (!problem.empty()) return where + ": " + problem;
+        }
+    }
+    if (auto it = m.find("grid"); it != m.end() && it->is_array()) {
+        if (it->size() != 2 || !(*it)[0].is_number_integer() || !(*it)[1].is_number_integer())
+            return "\"grid\" is not [nTheta, nPhi]";
+        const std::string problem = gridProblem((*it)[0].get<int>(), (*it)[1].get<int>());
+        if (!problem.empty()) return "\"grid\": " + problem;
+    }
+    if (auto it = m.find("filterWidth"); it != m.end()) {
+        if (!it->is_number() || !(it->get<double>() >= 0.0) ||
+            it->get<double>() > limits::kMaxFilterWidth)
+            return str("\"filterWidth\" ", it->dump(), " is not in [0, ", limits::kMaxFilterWidth, "]");
+    }
+    if (auto it = m.find("maxBounces"); it != m.end()) {
+        if (!it->is_number_integer() || it->get<int64_t>() < 1 ||
+            it->get<int64_t>() > limits::kMaxBounces)
+            return str("\"maxBounces\" ", it->dump(), " is not in [1, ", limits::kMaxBounces, "]");
+    }
+    if (auto it = m.find("branch"); it != m.end()) {
+        if (*it != "fresnel" && *it != "transmit")
+            return str("\"branch\" ", it->dump(), " is not \"fresnel\" or \"transmit\"");
+    }
+    if (auto it = m.find("input"); it != m.end() && !it->is_string())
+        return "\"input\" is not a string";
+    return "";
 }
 
 // Checks that `part` is a scanline part of width x height with the channels (and types) given.
@@ -596,6 +724,43 @@ void readWhole(Imf::MultiPartInputFile& file, int part, Planes& planes, int heig
     in.setFrameBuffer(planes.frameBuffer(0));
     in.readPixels(0, height - 1);
     if (verifier.on()) verifier.check(name, checksumHex(planes.bytes().data(), planes.bytes().size()));
+}
+
+// The weights part into out[(k * N + i) * 4 + c], a band of rows at a time, dequantized to float.
+// Verified, every row is read (the checksum covers the padding past the last sample too).
+void readWeights(Imf::MultiPartInputFile& file, int part, const WeightsPart& shape, float* out,
+                 const U8Params& u8, const Verifier& verifier) {
+    const int K = shape.K;
+    const size_t N = shape.N;
+    const std::vector<Channel> channels = weightChannels(K, shape.precision);
+    Imf::InputPart in(file, part);
+    Checksum sum;
+    for (int y0 = 0; y0 < shape.height && (verifier.on() || shape.map || size_t(y0) * shape.width < N);
+         y0 += kChunkRows) {
+        const int rows = std::min(kChunkRows, shape.height - y0);
+        Planes chunk(shape.width, rows, channels);
+        in.setFrameBuffer(chunk.frameBuffer(y0));
+        in.readPixels(y0, y0 + rows - 1);
+        sum.update(chunk.bytes().data(), chunk.bytes().size());
+        for (size_t t = 0; t < size_t(shape.width) * rows; ++t) {
+            const uint32_t i = sampleOfTexel(shape.map, size_t(y0) * shape.width + t, N);
+            if (i == kNoSample) continue;
+            for (int k = 0; k < K; ++k) {
+                float* w = &out[(size_t(k) * N + i) * 4];
+                if (shape.precision == Precision::U8) {
+                    const uint32_t packed = chunk.u(t, k);
+                    for (int c = 0; c < 4; ++c)
+                        w[c] = dequantU8(u8.scale[k * 4 + c], u8.offset[k * 4 + c],
+                                         (packed >> (8 * c)) & 0xffu);
+                } else {
+                    for (int c = 0; c < 4; ++c)
+                        w[c] = shape.precision == Precision::F16 ? chunk.h(t, k * 4 + c)
+                                                                 : chunk.f(t, k * 4 + c);
+                }
+            }
+        }
+    }
+    verifier.check(kWeightsPart, sum.hex());
 }
 
 // The manifest text of part 0, checked against its checksum and the copies in the other parts.
@@ -662,9 +827,9 @@ void readChartParts(Imf::MultiPartInputFile& file, Find find, const json& layout
     }
 }
 
-BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
-    // The manifest of the first part is the one that counts. Its version decides how it is
-    // verified, so it is parsed once unverified, then taken again through its checksum.
+// The manifest of the first part, the one that counts. Its version decides how it is verified,
+// so it is parsed once unverified, then taken again through its checksum.
+json openManifest(Imf::MultiPartInputFile& file, bool verify, int* version) {
     const auto* raw = file.header(0).findTypedAttribute<Imf::StringAttribute>(kManifestAttribute);
     if (!raw) throw InputError("not a shrefract bake (no \"shrefract.manifest\" attribute)");
     json m = json::parse(raw->value(), nullptr, /*allow_exceptions=*/false);
@@ -672,12 +837,27 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
         throw InputError("not a shrefract bake (the manifest is not a JSON object)");
     if (!m.contains("format") || m["format"] != "shrefract")
         throw InputError("not a shrefract bake (manifest \"format\" is not \"shrefract\")");
-    const int version = manifestInt(m, "version");
-    if (version > kFormatVersion)
-        throw InputError(str("format version ", version, " is newer than this build reads (",
+    *version = manifestInt(m, "version");
+    if (*version > kFormatVersion)
+        throw InputError(str("format version ", *version, " is newer than this build reads (",
                              kFormatVersion, ")"));
-    if (version < 1) throw InputError(str("format version ", version, " is invalid"));
-    manifestText(file, version, options.verify);
+    if (*version < 1) throw InputError(str("format version ", *version, " is invalid"));
+    manifestText(file, *version, verify);
+    return m;
+}
+
+// "slice 2 of 4" from a shard manifest's "shard" object, for messages.
+std::string sliceName(const json& shard) {
+    return str("slice ", shard.value("index", -1), " of ", shard.value("count", -1));
+}
+
+// `fileBytes`: the file's size, which bounds what its parts can decode to.
+BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options, uint64_t fileBytes) {
+    int version = 0;
+    json m = openManifest(file, options.verify, &version);
+    if (m.contains("shard"))
+        throw InputError(str("is a shard (", sliceName(m["shard"]),
+                             " of a bake), not a bake: merge a bake's shards with shrefract-merge"));
     std::vector<std::string> warnings;
     if (version < 2)
         warnings.push_back(str("format version ", version,
@@ -701,7 +881,10 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
     }
 
     d.order = manifestInt(m, "order");
-    if (d.order < 0 || d.order > 100) throw InputError(str("SH order ", d.order, " is absurd"));
+    if (d.order < 0 || d.order > limits::kMaxOrder)
+        throw InputError(str("SH order ", d.order, " is not in [0, ", limits::kMaxOrder, "]"));
+    if (const std::string problem = manifestProblem(m); !problem.empty())
+        throw InputError("manifest: " + problem);
     const int K = d.coefficientCount();
     if (manifestInt(m, "coefficients") != K)
         throw InputError(str("manifest says ", manifestInt(m, "coefficients"),
@@ -728,6 +911,10 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
         throw InputError(
             str(N, " samples do not fit the ", L.muWidth, " x ", L.muHeight, " mu layout"));
     if (nlLength < 0) throw InputError(str("neighbour list length ", nlLength, " is negative"));
+    for (int side : {L.muWidth, L.muHeight, L.rhoWidth, L.rhoHeight, nlWidth})
+        if (side > limits::kMaxTextureSize)
+            throw InputError(str("manifest sizes are invalid: a side of ", side, " texels is above ",
+                                 limits::kMaxTextureSize));
     U8Params u8;
     if (d.precision == Precision::U8) {
         if (!m.contains("u8")) throw InputError("8-bit bake without \"u8\" scale and offset");
@@ -758,6 +945,15 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
     if (int64_t(nlWidth) * nlHeight < nlLength)
         throw InputError(str("neighbour list of ", nlLength, " entries does not fit its ", nlWidth,
                              " x ", nlHeight, " part"));
+    // zlib inflates at most ~1032:1, so the parts cannot hold more than ~1100 times the file's
+    // bytes: sizes beyond that are corrupt, and are refused before anything is allocated.
+    const uint64_t muTexels = uint64_t(L.muWidth) * uint64_t(L.muHeight);
+    const uint64_t pixelBytes = muTexels * weightsTexelBytes(K, d.precision) + muTexels * (28 + 8) +
+                                uint64_t(L.rhoWidth) * uint64_t(L.rhoHeight) * 16 +
+                                uint64_t(nlWidth) * uint64_t(std::max(nlHeight, 0)) * 8;
+    if (pixelBytes > 1100 * fileBytes + (1u << 20))
+        throw InputError(str("truncated or corrupt: its parts would hold ", pixelBytes,
+                             " bytes, more than a file of ", fileBytes, " bytes can"));
 
     // rho first: in a chart layout it says where each sample sits in the mu parts.
     Planes rhoPlanes(L.rhoWidth, L.rhoHeight, kRhoChannels);
@@ -786,40 +982,11 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
                 throw InputError(str("inconsistent bake: sample ", i, " has no atlas texel"));
     }
 
-    // Weights, a band of rows at a time, dequantized to float. Verified, every row is read (the
-    // checksum covers the padding past the last sample too).
     d.weights.assign(size_t(K) * N * 4, 0.0f);
-    {
-        Imf::InputPart in(file, pWeights);
-        Checksum sum;
-        for (int y0 = 0; y0 < L.muHeight && (verifier.on() || L.isChartLayout() ||
-                                             int64_t(y0) * L.muWidth < N);
-             y0 += kChunkRows) {
-            const int rows = std::min(kChunkRows, L.muHeight - y0);
-            Planes chunk(L.muWidth, rows, wChannels);
-            in.setFrameBuffer(chunk.frameBuffer(y0));
-            in.readPixels(y0, y0 + rows - 1);
-            sum.update(chunk.bytes().data(), chunk.bytes().size());
-            for (size_t t = 0; t < size_t(L.muWidth) * rows; ++t) {
-                const uint32_t i = sampleOfTexel(texelMap, size_t(y0) * L.muWidth + t, size_t(N));
-                if (i == kNoSample) continue;
-                for (int k = 0; k < K; ++k) {
-                    float* w = &d.weights[(size_t(k) * N + i) * 4];
-                    if (d.precision == Precision::U8) {
-                        const uint32_t packed = chunk.u(t, k);
-                        for (int c = 0; c < 4; ++c)
-                            w[c] = dequantU8(u8.scale[k * 4 + c], u8.offset[k * 4 + c],
-                                             (packed >> (8 * c)) & 0xffu);
-                    } else {
-                        for (int c = 0; c < 4; ++c)
-                            w[c] = d.precision == Precision::F16 ? chunk.h(t, k * 4 + c)
-                                                                 : chunk.f(t, k * 4 + c);
-                    }
-                }
-            }
-        }
-        verifier.check(kWeightsPart, sum.hex());
-    }
+    readWeights(file, pWeights,
+                {nullptr, size_t(N), K, d.precision, L.muWidth, L.muHeight,
+                 texelMap.empty() ? nullptr : texelMap.data()},
+                d.weights.data(), u8, verifier);
 
     Planes samples(L.muWidth, L.muHeight, kSampleChannels);
     readWhole(file, pSamples, samples, L.muHeight, verifier, kSamplesPart);
@@ -851,9 +1018,78 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options) {
 
     const std::string problem = inconsistency(d);
     if (!problem.empty()) throw InputError("inconsistent bake: " + problem);
+    if (auto media = m.find("media"); media != m.end() && !media->empty()) {
+        for (int i = 0; i < N; ++i)
+            if (L.part[i] >= media->size())
+                throw InputError(str("inconsistent bake: sample ", i, " lies on part ", L.part[i],
+                                     " but the manifest has ", media->size(), " media"));
+    }
     d.manifest = std::move(m);
     d.warnings = std::move(warnings);
     return d;
+}
+
+ShardData readShardParts(Imf::MultiPartInputFile& file, bool weights) {
+    int version = 0;
+    json m = openManifest(file, true, &version);
+    if (!m.contains("shard") || !m["shard"].is_object())
+        throw InputError("is a bake, not a shard (its manifest has no \"shard\")");
+    if (version < 2) throw InputError(str("shard of format version ", version, " (shards are 2+)"));
+    const Verifier verifier(m, true);
+    ShardData d;
+    d.order = manifestInt(m, "order");
+    if (d.order < 0 || d.order > 100) throw InputError(str("SH order ", d.order, " is absurd"));
+    const int K = shEvenCount(d.order);
+    if (manifestInt(m, "coefficients") != K)
+        throw InputError(str("manifest says ", manifestInt(m, "coefficients"),
+                             " coefficients, order ", d.order, " has ", K));
+    if (m.value("precision", "") != "f32") throw InputError("shard weights are not f32");
+    const int N = manifestInt(m, "sampleCount");
+    const std::vector<int> size = manifestInts(m, "weightsSize", 2);
+    if (N < 0 || size[0] < 1 || size[1] < 1 || int64_t(N) > int64_t(size[0]) * size[1])
+        throw InputError(str(N, " samples do not fit the ", size[0], " x ", size[1], " weights part"));
+    d.sampleCount = size_t(N);
+    if (weights) {
+        int part = -1;
+        for (int p = 0; p < file.parts(); ++p)
+            if (file.header(p).hasName() && file.header(p).name() == kWeightsPart) part = p;
+        if (part < 0) throw InputError(str("missing part \"", kWeightsPart, "\""));
+        checkPart(file.header(part), kWeightsPart, size[0], size[1], weightChannels(K, Precision::F32));
+        d.weights.assign(size_t(K) * d.sampleCount * 4, 0.0f);
+        readWeights(file, part, {nullptr, d.sampleCount, K, Precision::F32, size[0], size[1]},
+                    d.weights.data(), U8Params{}, verifier);
+    }
+    d.manifest = std::move(m);
+    return d;
+}
+
+// Opens `path` for one of the readers, turning every failure into an InputError naming it.
+template <class Read>
+auto readFile(const std::string& path, Read&& read) {
+    std::error_code ec;
+    const auto status = std::filesystem::status(path, ec);
+    if (!std::filesystem::exists(status)) throw inputError(path, "file not found");
+    if (std::filesystem::is_directory(status))
+        throw inputError(path, "is a directory, not a bake file");
+    if (!std::filesystem::is_regular_file(status))
+        throw inputError(path, "is not a regular file (a FIFO or device?), not a bake file");
+
+    checkExrHeaders(path);  // before OpenEXR allocates what a damaged header claims
+    std::unique_ptr<Imf::MultiPartInputFile> file;
+    try {
+        file = std::make_unique<Imf::MultiPartInputFile>(path.c_str());
+    } catch (const std::exception& e) {
+        throw inputError(path, str("not an OpenEXR file: ", e.what()));
+    }
+    try {
+        return read(*file, uint64_t(std::filesystem::file_size(path, ec)));
+    } catch (const InputError& e) {
+        throw inputError(path, e.what());
+    } catch (const Iex::BaseExc& e) {
+        throw inputError(path, str("truncated or corrupt: ", e.what()));
+    } catch (const std::bad_alloc&) {
+        throw inputError(path, "sizes too large to load");
+    }
 }
 
 }  // namespace
@@ -866,7 +1102,8 @@ void writeBake(const std::string& path, const BakeData& data) {
         throw std::invalid_argument("writeBake(" + path + "): the manifest is not a JSON object");
     const SurfaceLayout& L = data.layout;
     const U8Params u8 = data.precision == Precision::U8 ? fitU8(data) : U8Params{};
-    const auto [nlWidth, nlHeight] = neighbourListSize(L.neighbourIndex.size());
+    const std::pair<int, int> nlSize = neighbourListSize(L.neighbourIndex.size());
+    const int nlWidth = nlSize.first, nlHeight = nlSize.second;  // (lambdas below capture them)
 
     // The parts' pixels are staged first: their checksums go into the manifest, which every
     // part's header carries.
@@ -970,7 +1207,7 @@ void writeBake(const std::string& path, const BakeData& data) {
         m.erase("u8");
     m["checksums"] = {{"algorithm", kChecksumAlgorithm},
                       {"parts",
-                       {{kWeightsPart, weightsChecksum(data, u8, texelMap)},
+                       {{kWeightsPart, weightsChecksum(weightsPart(data, texelMap), u8)},
                         {kSamplesPart, sum(samples)},
                         {kRhoPart, sum(rho)},
                         {kNeighboursPart, sum(neighbours)},
@@ -1000,59 +1237,68 @@ void writeBake(const std::string& path, const BakeData& data) {
         addChannels(headers.back(), p.channels);
     }
 
-    const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-    try {
-        std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
-        if (!os) throw inputError(path, str("cannot create ", tmp, ": ", std::strerror(errno)));
-        {
-            Imf::StdOFStream stream(os, tmp.c_str());
+    writeAtomically(path, [&](const std::string& staged) {
+        writeExrFile(staged, [&](Imf::OStream& stream) {
             Imf::MultiPartOutputFile file(stream, headers.data(), int(headers.size()));
-            writeWeights(file, 0, data, u8, texelMap);
+            writeWeights(file, 0, weightsPart(data, texelMap), u8);
             writeWhole(file, 1, samples, L.muHeight);
             writeWhole(file, 2, rho, L.rhoHeight);
             writeWhole(file, 3, neighbours, L.muHeight);
             writeWhole(file, 4, list, nlHeight);
             for (size_t p = 0; p < chartParts.size(); ++p)
                 writeWhole(file, int(5 + p), chartParts[p].planes, chartParts[p].height);
-        }  // the destructor writes the chunk offset tables; it swallows errors, the stream not
-        os.flush();
-        os.close();
-        if (os.fail())
-            throw inputError(path, str("cannot write ", tmp, ": ", std::strerror(errno)));
-        syncFile(tmp);
-        if (std::rename(tmp.c_str(), path.c_str()) != 0)
-            throw inputError(path, str("cannot rename ", tmp, " to it: ", std::strerror(errno)));
-    } catch (const Iex::BaseExc& e) {
-        std::remove(tmp.c_str());
-        throw inputError(path, str("cannot write: ", e.what()));
-    } catch (...) {
-        std::remove(tmp.c_str());
-        throw;
-    }
+        });
+    });
 }
 
 BakeData readBake(const std::string& path, const ReadOptions& options) {
-    std::error_code ec;
-    const auto status = std::filesystem::status(path, ec);
-    if (!std::filesystem::exists(status)) throw inputError(path, "file not found");
-    if (std::filesystem::is_directory(status))
-        throw inputError(path, "is a directory, not a bake file");
+    return readFile(path, [&](Imf::MultiPartInputFile& file, uint64_t bytes) {
+        return readParts(file, options, bytes);
+    });
+}
 
-    std::unique_ptr<Imf::MultiPartInputFile> file;
+void writeShard(const std::string& path, const ShardData& shard) {
+    const int K = shEvenCount(shard.order);
+    if (shard.order < 0 || shard.weights.size() != size_t(K) * shard.sampleCount * 4)
+        throw std::invalid_argument(str("writeShard(", path, "): ", shard.weights.size(),
+                                        " weights, expected ", K, " coefficients x ",
+                                        shard.sampleCount, " samples x 4"));
+    if (!shard.manifest.is_object() || !shard.manifest.contains("shard") ||
+        !shard.manifest["shard"].is_object())
+        throw std::invalid_argument("writeShard(" + path + "): the manifest has no \"shard\" object");
+    const auto [width, height] = neighbourListSize(shard.sampleCount);
+    const WeightsPart part{shard.weights.data(), shard.sampleCount, K, Precision::F32, width, height};
+    json m = shard.manifest;
+    m["format"] = "shrefract";
+    m["version"] = kFormatVersion;
+    m["order"] = shard.order;
+    m["coefficients"] = K;
+    m["precision"] = "f32";
+    m["sampleCount"] = shard.sampleCount;
+    m["weightsSize"] = {width, height};
+    m["checksums"] = {{"algorithm", kChecksumAlgorithm},
+                      {"parts", {{kWeightsPart, weightsChecksum(part, U8Params{})}}}};
+    std::string text;
     try {
-        file = std::make_unique<Imf::MultiPartInputFile>(path.c_str());
-    } catch (const std::exception& e) {
-        throw inputError(path, str("not an OpenEXR file: ", e.what()));
+        text = m.dump();
+    } catch (const json::exception& e) {
+        throw std::invalid_argument("writeShard(" + path + "): manifest: " + e.what());
     }
-    try {
-        return readParts(*file, options);
-    } catch (const InputError& e) {
-        throw inputError(path, e.what());
-    } catch (const Iex::BaseExc& e) {
-        throw inputError(path, str("truncated or corrupt: ", e.what()));
-    } catch (const std::bad_alloc&) {
-        throw inputError(path, "sizes too large to load");
-    }
+    // Float weights hardly compress (docs/format.md "Size"): shards are stored uncompressed.
+    std::vector<Imf::Header> headers = {partHeader(kWeightsPart, width, height,
+                                                   Imath::Box2i({0, 0}, {width - 1, height - 1}),
+                                                   text, Imf::NO_COMPRESSION)};
+    addChannels(headers[0], weightChannels(K, Precision::F32));
+    writeAtomically(path, [&](const std::string& staged) {
+        writeExrFile(staged, [&](Imf::OStream& stream) {
+            Imf::MultiPartOutputFile file(stream, headers.data(), int(headers.size()));
+            writeWeights(file, 0, part, U8Params{});
+        });
+    });
+}
+
+ShardData readShard(const std::string& path, bool weights) {
+    return readFile(path, [&](Imf::MultiPartInputFile& file, uint64_t) { return readShardParts(file, weights); });
 }
 
 }  // namespace shrefract

@@ -2,21 +2,37 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include <ImfArray.h>
 #include <ImfRgbaFile.h>
+#include <ImfStringAttribute.h>
 
 #include "common/error.h"
+#include "common/exr_input.h"
 
 namespace shrefract {
 
 LatLongImage loadLatLong(const std::string& path) {
     LatLongImage img;
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) throw inputError(path, "file not found");
+    if (!std::filesystem::is_regular_file(path, ec))
+        throw inputError(path, "is not a regular file, not an environment image");
+    checkExrHeaders(path);  // before OpenEXR allocates what a damaged header claims
     try {
         Imf::RgbaInputFile file(path.c_str());
+        // A multi-part file (a shrefract bake) opens as its first part, which has no colour:
+        // it would render black without a word.
+        if (file.header().findTypedAttribute<Imf::StringAttribute>("shrefract.manifest"))
+            throw inputError(path, "is a shrefract bake, not an environment image");
+        if (!(file.channels() & Imf::WRITE_RGB) && !(file.channels() & Imf::WRITE_Y))
+            throw inputError(path, "has no colour channels (R, G, B or Y): not an environment image");
         Imath::Box2i dw = file.dataWindow();
         img.width = dw.max.x - dw.min.x + 1;
         img.height = dw.max.y - dw.min.y + 1;
+        const std::string size = latLongProblem(img.width, img.height, {});
+        if (!size.empty()) throw inputError(path, size);
         const int w = img.width, h = img.height;
         Imf::Array2D<Imf::Rgba> pixels(h, w);
         file.setFrameBuffer(&pixels[0][0] - dw.min.x - dw.min.y * w, 1, w);
@@ -30,11 +46,35 @@ LatLongImage loadLatLong(const std::string& path) {
                 o[1] = p.g;
                 o[2] = p.b;
             }
+    } catch (const InputError&) {
+        throw;
     } catch (const std::exception& e) {
         throw inputError(path, std::string("cannot read environment EXR: ") + e.what());
     }
-    if (img.width < 2 || img.height < 1) throw inputError(path, "environment image is empty");
+    const std::string problem = latLongProblem(img.width, img.height, img.rgb);
+    if (!problem.empty()) throw inputError(path, problem);
     return img;
+}
+
+std::string latLongProblem(int width, int height, const std::vector<float>& rgb) {
+    const std::string size = std::to_string(width) + " x " + std::to_string(height);
+    if (width < 2 || height < 1) return "environment image is " + size + ": empty";
+    if (width > 65536) return "environment image is " + size + ": wider than 65536";
+    if (std::abs(width - 2 * height) > 1)
+        return "environment image is " + size +
+               ": a lat-long image is twice as wide as high (+-1 pixel)";
+    if (rgb.empty()) return "";
+    if (rgb.size() != size_t(width) * size_t(height) * 3)
+        return "environment image holds " + std::to_string(rgb.size()) + " values, expected " +
+               size + " x 3";
+    size_t bad = 0, first = 0;
+    for (size_t i = 0; i < rgb.size(); ++i)
+        if (!std::isfinite(rgb[i]) && bad++ == 0) first = i / 3;
+    if (bad > 0)
+        return std::to_string(bad) + " values are not finite (NaN or inf), the first at pixel (" +
+               std::to_string(first % size_t(width)) + ", " + std::to_string(first / size_t(width)) +
+               ")";
+    return "";
 }
 
 glm::vec3 sampleLatLong(int w, int h, const std::vector<float>& rgb, glm::vec3 d) {

@@ -16,8 +16,14 @@ struct LatLongImage {
     std::vector<float> rgb;  // row-major, row 0 = top (+y)
 };
 
-// Reads an RGB(A) EXR; throws InputError naming the file.
+// Reads an RGB(A) EXR and checks it (checkLatLong); throws InputError naming the file: missing,
+// not an OpenEXR image, a shrefract bake or another file without colour channels, a bad image.
 LatLongImage loadLatLong(const std::string& path);
+
+// What is wrong with a lat-long image, or "" when it is usable: the width must be twice the
+// height (+-1 pixel; 101 x 37 or 16384 x 8 is no panorama), at most 65536 wide, and every value
+// finite (a NaN or inf pixel spreads into every output pixel that filters it).
+std::string latLongProblem(int width, int height, const std::vector<float>& rgb);
 
 // Bilinear lookup at unit direction d: wraps in u, clamps in v at the poles.
 glm::vec3 sampleLatLong(const LatLongImage& image, glm::vec3 d);

@@ -24,6 +24,7 @@
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 
 #include "common/error.h"
+#include "common/mesh_counts.h"
 
 namespace shrefract {
 
@@ -295,6 +296,7 @@ Mesh loadMesh(const std::string& path, MeshReport* report) {
     if (fs::file_size(path, ec) == 0) throw inputError(path, "file is empty");
 
     scanTextForNonFinite(path, ext);
+    checkMeshCounts(path, ext);  // a file cut short: OpenMesh would take the part it got
 
     OMesh om;
     om.request_vertex_normals();

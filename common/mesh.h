@@ -34,7 +34,8 @@ struct MeshReport {
 
 // Loads and validates. Polygons are triangulated; vertex normals come from the file when it has
 // them, else are area-weighted face normals. Throws InputError naming the file on: not found,
-// unsupported extension, unparsable, empty (no triangles left), NaN/inf coordinates.
+// unsupported extension, unparsable, cut short (fewer vertices or faces than its header
+// promises: common/mesh_counts.h), empty (no triangles left), NaN/inf coordinates.
 Mesh loadMesh(const std::string& path, MeshReport* report = nullptr);
 
 }  // namespace shrefract

@@ -23,8 +23,6 @@ using nlohmann::json;
 // to a default, so it is rejected.
 const char* const kPartKeys[] = {"name",     "mesh",  "ior",      "absorption",
                                  "priority", "scale", "translate"};
-constexpr double kMinIor = 1.0;  // below 1 is not a dielectric we trace
-constexpr double kMaxIor = 5.0;  // well past diamond (2.42) and rutile (2.9): likely a typo
 
 std::string allowedPartKeys() {
     std::string s;
@@ -37,24 +35,6 @@ bool endsWithJson(const std::string& path) {
     std::transform(ext.begin(), ext.end(), ext.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     return ext == ".json";
-}
-
-std::string numberString(double x) {
-    std::ostringstream os;
-    os << x;
-    return os.str();
-}
-
-// Checks a medium's numbers; returns the problem, or an empty string when it is fine.
-std::string mediumProblem(const Medium& m) {
-    if (!std::isfinite(m.ior) || m.ior < kMinIor || m.ior > kMaxIor)
-        return "'ior' " + numberString(m.ior) + " is not in [1, 5]";
-    for (int c = 0; c < 3; ++c) {
-        if (!std::isfinite(m.absorption[c]) || m.absorption[c] < 0.0)
-            return "'absorption' has " + numberString(m.absorption[c]) +
-                   ": each of the 3 values must be finite and >= 0";
-    }
-    return {};
 }
 
 // nlohmann::json stores non-finite doubles as numbers when built in code but never parses

@@ -32,6 +32,11 @@ struct Scene {
     std::vector<Part> parts;
 };
 
+// What is wrong with a medium, or "" when it is fine: ior in [limits::kMinIor, kMaxIor], each
+// absorption finite and >= 0. The one check for the bake's --ior, scene files and the media in a
+// bake file's manifest.
+std::string mediumProblem(const Medium& m);
+
 // Loads `path`: a .json scene, or a mesh file as one part with medium `defaultMedium`.
 // Throws InputError naming the file on any problem (including every mesh's own errors and
 // absurd media: ior not in [1, 5], negative or non-finite absorption).

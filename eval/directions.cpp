@@ -8,6 +8,7 @@
 #include <limits>
 #include <numeric>
 #include <random>
+#include <sstream>
 
 #include "bake/tracer.h"
 #include "common/decompress.h"
@@ -259,7 +260,8 @@ glm::vec4 queryChart(const BakeData& bake, glm::vec3 p, glm::vec3 omega) {
 }  // namespace
 
 std::vector<glm::vec4> queryBake(const BakeData& bake, const std::vector<glm::vec3>& p,
-                                 const std::vector<glm::vec3>& w) {
+                                 const std::vector<glm::vec3>& w, float maxDistance) {
+    SHREFRACT_CHECK_EQ(p.size(), w.size());
     const SurfaceLayout& L = bake.layout;
     if (L.isChartLayout()) {
         std::vector<glm::vec4> out(p.size());
@@ -271,10 +273,15 @@ std::vector<glm::vec4> queryBake(const BakeData& bake, const std::vector<glm::ve
         return out;
     }
     const int r = L.rate;
+    if (maxDistance < 0.0f && !L.position.empty()) {
+        glm::vec3 lo = L.position[0], hi = L.position[0];
+        for (const glm::vec3& x : L.position) lo = glm::min(lo, x), hi = glm::max(hi, x);
+        maxDistance = kQueryDistance * glm::length(hi - lo);
+    }
     std::vector<glm::vec4> values(L.sampleCount(), glm::vec4(0.0f));
     std::vector<glm::vec4> out(p.size());
     for (size_t q = 0; q < p.size(); ++q) {
-        int bestT = 0;
+        int bestT = -1;
         glm::vec2 bestUV(0.0f);
         float bestD = std::numeric_limits<float>::max();
         for (int t = 0; t < L.triangleCount; ++t) {
@@ -284,7 +291,27 @@ std::vector<glm::vec4> queryBake(const BakeData& bake, const std::vector<glm::ve
             glm::vec2 uv = closestBarycentric(p[q], a, b, c, &d2);
             if (d2 < bestD) bestD = d2, bestT = t, bestUV = uv;
         }
+        if (bestT < 0) throw QueryRefused(q, "the bake has no triangles");
+        const float distance = std::sqrt(bestD);
+        if (!(distance <= maxDistance)) {
+            std::ostringstream os;
+            os << "point (" << p[q].x << ", " << p[q].y << ", " << p[q].z << ") is " << distance
+               << " from the surface (at most " << maxDistance << ")";
+            throw QueryRefused(q, os.str());
+        }
+        // The outward geometric normal, turned to agree with the corners' shading normals.
+        const uint32_t s0 = L.sampleAt(bestT, 0, 0), s1 = L.sampleAt(bestT, r, 0),
+                       s2 = L.sampleAt(bestT, 0, r);
+        glm::vec3 n = glm::cross(L.position[s1] - L.position[s0], L.position[s2] - L.position[s0]);
+        if (glm::dot(n, L.normal[s0] + L.normal[s1] + L.normal[s2]) < 0.0f) n = -n;
         const glm::vec3 omega = glm::normalize(w[q]);
+        if (glm::dot(omega, glm::normalize(n)) < -1e-4f) {
+            std::ostringstream os;
+            os << "view direction (" << w[q].x << ", " << w[q].y << ", " << w[q].z
+               << ") points into the surface (its normal there is (" << glm::normalize(n).x << ", "
+               << glm::normalize(n).y << ", " << glm::normalize(n).z << "))";
+            throw QueryRefused(q, os.str());
+        }
         for (int j = 0; j <= r; ++j)
             for (int i = 0; i + j <= r; ++i) {
                 uint32_t s = L.sampleAt(bestT, i, j);

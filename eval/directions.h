@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/bakefile.h"
+#include "common/error.h"
 #include "common/scene.h"
 
 namespace shrefract {
@@ -33,13 +34,24 @@ nlohmann::json evaluateDirections(const BakeData& bake, const Scene& scene, size
 // hemisphere (the SH themselves are the yardstick, so no tracing is needed).
 std::vector<int> adaptiveOrders(const BakeData& bake, double toleranceDeg);
 
-// For each object-space surface point p and unit view direction w (toward the viewer): the
-// exit direction (normalized) and length the runtime would use there, interpolated across the
+// Why queryBake refused a query: its index in p and w, and the problem.
+struct QueryRefused : InputError {
+    QueryRefused(size_t i, const std::string& problem) : InputError(problem), index(i) {}
+    size_t index;
+};
+
+// For each object-space surface point p and view direction w (toward the viewer): the exit
+// direction (normalized) and length the runtime would use there, interpolated across the
 // nearest triangle exactly as the rho layout does (interpolateRho); for chart bakes looked up in
 // the atlas as the runtime's refraction map holds it (chartRefractionMap: the bake's gutter,
 // seam-aware). Viewer at infinity along w.
+// Refuses (QueryRefused) a point farther than `maxDistance` from the surface (object units; < 0:
+// kQueryDistance of the bake's bounding-box diagonal) and a view direction below the surface
+// there (w . n < -1e-4 |w|, n the nearest triangle's outward geometric normal): the bake knows
+// nothing there, and an answer would look as good as any other.
+constexpr float kQueryDistance = 1e-3f;
 std::vector<glm::vec4> queryBake(const BakeData& bake, const std::vector<glm::vec3>& p,
-                                 const std::vector<glm::vec3>& w);
+                                 const std::vector<glm::vec3>& w, float maxDistance = -1.0f);
 
 // Summary statistics of a list of errors: mean, median, p95, p99, max, count.
 nlohmann::json errorStats(std::vector<double> e);

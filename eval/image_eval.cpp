@@ -146,6 +146,27 @@ nlohmann::json compareImages(const EvalBuffer& ref, const EvalBuffer& test, floa
     }
     const double mse = se / (3.0 * std::max<size_t>(1, e.size()));
     const double psnr = mse > 0 ? 10.0 * std::log10(1.0 / mse) : 99.0;  // 99: identical
+    // Where the squared error lies: silhouette pixels (the reference's coverage changes within
+    // their 3 x 3 neighbourhood: the GL methods draw one sample per pixel there), the object's
+    // interior, and the background; and the PSNR over the interior alone.
+    double seClass[3] = {0, 0, 0};  // edge, interior, background
+    size_t nInterior = 0;
+    for (int y = 0; y < ref.height; ++y)
+        for (int x = 0; x < ref.width; ++x) {
+            const size_t i = static_cast<size_t>(y) * ref.width + x;
+            bool edge = false;
+            for (int dy = -1; dy <= 1 && !edge; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const int xx = std::clamp(x + dx, 0, ref.width - 1), yy = std::clamp(y + dy, 0, ref.height - 1);
+                    if (ref.covered(static_cast<size_t>(yy) * ref.width + xx) != ref.covered(i)) edge = true;
+                }
+            const glm::vec3 d = toneMappedPixel(ref, i, exposure) - toneMappedPixel(test, i, exposure);
+            const int cls = edge ? 0 : ref.covered(i) ? 1 : 2;
+            seClass[cls] += glm::dot(d, d);
+            nInterior += cls == 1;
+        }
+    const double seAll = std::max(1e-30, seClass[0] + seClass[1] + seClass[2]);
+    const double mseInterior = seClass[1] / (3.0 * std::max<size_t>(1, nInterior));
     return {{"width", ref.width},
             {"height", ref.height},
             {"angleDeg", errorStats(angles)},
@@ -153,6 +174,10 @@ nlohmann::json compareImages(const EvalBuffer& ref, const EvalBuffer& test, floa
              {{"ref", cr}, {"test", ct}, {"both", both}, {"refOnly", refOnly},
               {"testOnly", testOnly}, {"mismatch", refOnly + testOnly}}},
             {"psnr", psnr},
+            {"psnrInterior", mseInterior > 0 ? 10.0 * std::log10(1.0 / mseInterior) : 99.0},
+            {"errorShare",
+             {{"silhouette", seClass[0] / seAll}, {"interior", seClass[1] / seAll},
+              {"background", seClass[2] / seAll}}},
             {"ssim", ssim(la, lb, ref.width, ref.height)}};
 }
 

@@ -30,7 +30,10 @@ std::vector<float> angularErrors(const EvalBuffer& ref, const EvalBuffer& test);
 
 // The report of `shrefract-eval image`: angleDeg {count, mean, median, p95, p99, max} over the
 // pixels both cover; coverage {ref, test, both, refOnly, testOnly, mismatch}; psnr (dB) over
-// all pixels and RGB of toneMapAces(colour) in [0, 1]; ssim: mean SSIM of the tone-mapped
+// all pixels and RGB of toneMapAces(colour) in [0, 1]; psnrInterior the same over the object's
+// interior pixels (covered by the reference, no coverage change in their 3 x 3 neighbourhood);
+// errorShare {silhouette, interior, background}: where the squared error lies (silhouette: the
+// reference's coverage changes within the 3 x 3 neighbourhood); ssim: mean SSIM of the tone-mapped
 // luminance (Rec. 709 weights), 11x11 Gaussian window sigma 1.5, K1 0.01, K2 0.03, L 1, over
 // the windows that lie inside the image. Throws InputError if the sizes differ.
 nlohmann::json compareImages(const EvalBuffer& ref, const EvalBuffer& test, float exposure = 1.0f);

@@ -71,6 +71,11 @@ struct ReferenceStats {
 EvalBuffer renderReference(const Tracer& tracer, const ReferenceEnvironment& environment,
                            const ReferenceView& view, ReferenceStats* stats = nullptr);
 
+// Dispersion: colour channel c of buffer c, the coverage and direction buffer of `green` (the
+// middle channel). How the reference renders one index per RGB channel (three renders, each
+// with the scene at that channel's index), and how three grey renders become one dispersive one.
+EvalBuffer composeChannels(const EvalBuffer& red, const EvalBuffer& green, const EvalBuffer& blue);
+
 // d_N of Wyman 2005 per point: the distance from p along the inward normal -n to the next
 // surface of the scene (0 if none), measured between true surface points. Parallel.
 std::vector<float> normalDistances(const Tracer& tracer, const std::vector<glm::vec3>& p,

@@ -19,6 +19,10 @@ uniform vec3 uEyeObject;
 #else
 uniform sampler2D uD;
 #endif
+#ifdef SHREFRACT_IOR_BRACKET
+uniform sampler2D uDB;  // shade_ior.frag's second bake (runtime/src/ior.h), same mu layout
+out vec4 vDB;
+#endif
 out vec3 vPosition;
 out vec3 vNormal;
 out vec4 vD;
@@ -31,6 +35,9 @@ void main() {
     vD = shPass(p, normalize(toLocalFrame(normalize(uEyeObject - P), N)), vec4(0.0));
 #else
     vD = texelFetch(uD, p, 0);
+#endif
+#ifdef SHREFRACT_IOR_BRACKET
+    vDB = texelFetch(uDB, p, 0);
 #endif
     vec4 world = uModel * vec4(P, 1.0);
     vPosition = world.xyz;

@@ -2,23 +2,26 @@
 // A thin shell over bake/ (bake.h); options in docs/bake.md.
 #include <CLI/CLI.hpp>
 
-#include <atomic>
-#include <csignal>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 
 #include "bake/bake.h"
 #include "bake/layout.h"
+#include "bake/shard.h"
 #include "bake/target.h"
 #include "bake/cmd/common_cli.h"
+#include "common/cli/cli.h"
 #include "common/error.h"
+#include "common/limits.h"
+#include "common/output.h"
 
 using namespace shrefract;
+namespace fs = std::filesystem;
 
 namespace {
-std::atomic<bool> gCancel{false};
-void onSignal(int) { gCancel = true; }
+constexpr const char* kTool = "shrefract-bake";
+using Clock = std::chrono::steady_clock;
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -35,7 +38,7 @@ int main(int argc, char** argv) {
     std::string targetReport;
     app.add_option("input", input, "mesh (.obj .off .ply .stl) or scene (.json)")->required();
     app.add_option("-o,--output", output, "output file, NAME.shrefract.exr")->required();
-    app.add_option("--order", opt.order, "SH order L: bands 0..L")->capture_default_str()->check(CLI::Range(0, 20));
+    app.add_option("--order", opt.order, "SH order L: bands 0..L")->capture_default_str()->check(CLI::Range(0, limits::kMaxOrder));
     std::string layout = "joining", texels;
     app.add_option("--layout", layout,
                    "joining: every triangle on a barycentric grid (paper 5.3); isolated: charts cut "
@@ -43,7 +46,7 @@ int main(int argc, char** argv) {
                    "coordinates as the charts")
         ->capture_default_str()->check(CLI::IsMember({"joining", "isolated", "uv"}));
     auto* rateOpt = app.add_option("--rate", rate, "joining: grid steps per triangle edge (overrides --samples)")
-                        ->check(CLI::Range(1, 64));
+                        ->check(CLI::Range(1, limits::kMaxRate));
     auto* texelsOpt = app.add_option("--texels", texels,
                                      "isolated, uv: the atlas size WxH or W (square), instead of "
                                      "the one whose covered texels reach --samples");
@@ -60,12 +63,12 @@ int main(int argc, char** argv) {
                    "isolated: largest angle in degrees between a face's normal and its chart's seed")
         ->capture_default_str()->check(CLI::Range(1.0, 89.0));
     app.add_option("--grid", grid, "view directions over the hemisphere, NTHETAxNPHI")->capture_default_str();
-    app.add_option("--ior", ior, "index of refraction for a bare mesh")->capture_default_str()->check(CLI::Range(1.0, 5.0));
+    app.add_option("--ior", ior, "index of refraction for a bare mesh")->capture_default_str()->check(CLI::Range(limits::kMinIor, limits::kMaxIor));
     app.add_option("--branch", branch, "fresnel: larger Fresnel branch; transmit: refract unless TIR")
         ->capture_default_str()->check(CLI::IsMember({"fresnel", "transmit"}));
-    app.add_option("--max-bounces", opt.trace.maxBounces, "bounce cap per path")->capture_default_str()->check(CLI::Range(1, 10000));
+    app.add_option("--max-bounces", opt.trace.maxBounces, "bounce cap per path")->capture_default_str()->check(CLI::Range(1, limits::kMaxBounces));
     app.add_option("--filter", opt.filterWidth, "semi-Gaussian SH low-pass width in bands (0: none)")
-        ->capture_default_str()->check(CLI::Range(0.0, 1000.0));
+        ->capture_default_str()->check(CLI::Range(0.0, limits::kMaxFilterWidth));
     std::string fit = ToString(opt.fit), weighting = opt.weighting.ToString();
     app.add_option("--fit", fit, "projection: W = M R through the compression matrix (the paper); lsq: "
                                  "least squares on the grid samples; weighted: least squares weighted by "
@@ -74,6 +77,10 @@ int main(int argc, char** argv) {
     app.add_option("--fit-weighting", weighting,
                    "--fit weighted: FLAGGED:DEG:DISAGREEING:TRIMDEG:TRIMMED:PASSES (bake/fit.h)")
         ->capture_default_str();
+    app.add_option("--footprint-samples", opt.footprintSamples,
+                   "rays per (sample, direction), averaged over the sample's footprint on the surface "
+                   "(1: the sample alone)")
+        ->capture_default_str()->check(CLI::Range(1, 64));
     app.add_option("--precision", precision, "weight storage: f32, f16 or u8")->capture_default_str()
         ->check(CLI::IsMember({"f32", "f16", "u8"}));
     app.add_option("--threads", opt.threads, "worker threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
@@ -83,10 +90,30 @@ int main(int argc, char** argv) {
                    "directions is at most DEG degrees (overrides --order, --rate, --grid)")
         ->check(CLI::Range(0.001, 180.0));
     app.add_option("--target-report", targetReport, "write the --target-error search as JSON");
+    std::string shardText, workDir, tracer = "coherent";
+    int checkpoints = 0;
+    bool resume = false;
+    app.add_option("--shard", shardText,
+                   "bake slice I of N (I/N) into the -o shard file for shrefract-merge; N alone: "
+                   "the index from SLURM_ARRAY_TASK_ID");
+    app.add_option("--checkpoints", checkpoints,
+                   "slices a whole bake writes to its work folder as it goes (0: one per 2^24 "
+                   "paths; 1: none)")->capture_default_str()->check(CLI::Range(0, 1000000));
+    app.add_option("--work", workDir, "the checkpoints' folder (default: OUTPUT.work)");
+    app.add_flag("--resume", resume,
+                 "keep the complete checkpoints of an interrupted bake (or, with --shard, a "
+                 "complete shard file) and bake only the rest");
+    app.add_option("--tracer", tracer, "coherent: a sample's paths as Embree ray streams; scalar: "
+                                       "one ray at a time (the reference)")
+        ->capture_default_str()->check(CLI::IsMember({"coherent", "scalar"}));
     app.add_flag("-q,--quiet", quiet, "no progress output");
-    CLI11_PARSE(app, argc, argv);
+    const auto start = Clock::now();
+    std::string checkpointDir;  // set once a checkpointed bake has begun
 
-    try {
+    return cli::run(app, kTool, argc, argv, [&] {
+      try {
+        // Stop cleanly on Ctrl-C or SIGTERM: the bake polls the flag, nothing is written.
+        opt.cancel = cli::cancelOnSignals();
         opt.rate = rate;
         opt.samples = samples;
         opt.layout = parseLayoutKind(layout);
@@ -112,10 +139,20 @@ int main(int argc, char** argv) {
         opt.fit = parseFit(fit);
         opt.weighting = FitWeighting::parse(weighting);
         opt.cacheDir = cache;
-        namespace fs = std::filesystem;
-        fs::path outDir = fs::absolute(output).parent_path();
-        if (!fs::is_directory(outDir))
-            throw inputError(output, "output folder " + outDir.string() + " does not exist");
+        opt.coherent = tracer == "coherent";
+        ShardSlice slice;
+        if (!shardText.empty()) {
+            slice = parseShard(shardText, std::getenv("SLURM_ARRAY_TASK_ID"));
+            if (targetError > 0)
+                throw InputError("--target-error cannot be combined with --shard: run the search "
+                                 "once, then shard with the --order, --rate and --grid it chose");
+        }
+        if (workDir.empty()) workDir = output + ".work";
+        // Every output checked and staged before the work: a bad path fails now, not after an
+        // hour of tracing, and nothing appears under its name until all are complete.
+        OutputSet outputs;
+        const std::string stagedBake = outputs.add(output);
+        const std::string stagedReport = targetReport.empty() ? "" : outputs.add(targetReport);
 
         Medium medium;
         medium.ior = ior;
@@ -138,11 +175,7 @@ int main(int argc, char** argv) {
             std::printf("  chosen: %.1f MB of weights (%.2fx less), %.3g paths (%.2fx less)\n", c.weightBytes / 1e6,
                         double(p.weightBytes) / std::max<size_t>(1, c.weightBytes), c.bakeCost,
                         p.bakeCost / std::max(1.0, c.bakeCost));
-            if (!targetReport.empty()) {
-                std::ofstream f(targetReport);
-                f << t.ToJson().dump(2) << "\n";
-                if (!f) throw inputError(targetReport, "cannot write");
-            }
+            if (!targetReport.empty()) writeFile(stagedReport, t.ToJson().dump(2) + "\n");
             opt.order = c.order;
             opt.rate = c.rate;
             opt.grid = c.grid;
@@ -154,7 +187,9 @@ int main(int argc, char** argv) {
             opt.progress = [&](const BakeProgress& p) {
                 double f = double(p.samplesDone) / std::max<size_t>(1, p.samplesTotal);
                 double rps = p.rays / std::max(1e-9, p.seconds);
-                double eta = f > 0 ? p.seconds * (1 - f) / f : 0;
+                // This run's pace over the samples it has done (not the resumed ones).
+                double g = double(p.samplesDone - p.samplesResumed) / std::max<size_t>(1, p.samplesTotal);
+                double eta = g > 0 ? p.seconds * (1 - f) / g : 0;
                 if (tty) {
                     int filled = static_cast<int>(f * 30);
                     std::fprintf(stderr, "\r[%-30s] %5.1f%%  %zu/%zu samples  %6.2f Mrays/s  ETA %s ",
@@ -167,15 +202,77 @@ int main(int argc, char** argv) {
                 }
             };
         }
-        std::signal(SIGINT, onSignal);
-        std::signal(SIGTERM, onSignal);
-        opt.cancel = &gCancel;
+        if (opt.layout == LayoutKind::Joining && opt.rate == 0) {
+            // Say what --samples becomes: the smallest rate reaching it, usually more samples.
+            opt.rate = rateForSampleCount(scene, opt.samples);
+            const size_t n = joiningSampleCount(scene, opt.rate);
+            if (n != opt.samples)
+                cli::note(kTool, "--samples " + std::to_string(opt.samples) + ": rate " +
+                                     std::to_string(opt.rate) + " gives " + std::to_string(n) +
+                                     " unique samples (" +
+                                     (n > opt.samples ? "the smallest rate that reaches it"
+                                                      : "the largest rate; it cannot reach it") +
+                                     ")");
+        }
 
-        BakeResult res = bake(scene, opt, input);
-        for (const std::string& w : res.stats.charts.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+        auto note = [&](const std::string& text) {
+            if (!quiet) std::fprintf(stderr, "%s%s\n", tty ? "\r" : "", text.c_str());
+        };
+        BakePlan plan(scene, opt, input);
+        for (const std::string& w : plan.chartStats().warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+        if (!shardText.empty()) {
+            // One slice into a shard file, for shrefract-merge.
+            if (resume && fs::exists(output)) {
+                try {
+                    const ShardData old = readShard(output);
+                    if (shardMismatch(old, shardIdentity(plan), slice, plan.batchCount()).empty()) {
+                        std::printf("%s: slice %d of %d is already complete\n", output.c_str(),
+                                    slice.index, slice.count);
+                        return int(cli::kOk);
+                    }
+                } catch (const InputError& e) {
+                    note(std::string("baking it again: ") + e.what());
+                }
+            }
+            const ShardData shard = bakeShard(plan, slice);
+            if (!quiet && tty) std::fprintf(stderr, "\n");
+            writeShard(stagedBake, shard);
+            if (opt.cancel->load()) throw Cancelled();  // a signal during the write: keep nothing
+            outputs.commit();
+            const BakeStats st = BakeStats::fromJson(shard.manifest["stats"]);
+            std::printf("baked %s slice %d of %d -> %s\n", input.c_str(), slice.index, slice.count,
+                        output.c_str());
+            std::printf("  samples     %zu of %zu (from %zu), paths %zu, rays %zu\n", shard.sampleCount,
+                        plan.sampleCount(), shard.manifest["shard"].value("first", size_t(0)), st.paths,
+                        st.rays);
+            std::printf("  time        %.1f s wall (layout %.1f s, slice %.1f s)\n",
+                        std::chrono::duration<double>(Clock::now() - start).count(), plan.setupSeconds(),
+                        st.wallSeconds);
+            return int(cli::kOk);
+        }
+        const int nCheckpoints = checkpointCount(plan, checkpoints);
+        BakeResult res;
+        if (nCheckpoints <= 1) {
+            SliceResult all = plan.bakeSlice(0, plan.batchCount());
+            res.stats = all.stats;
+            res.data = plan.data(std::move(all.weights), res.stats);
+        } else {
+            CheckpointOptions co;
+            co.workDir = workDir;
+            co.count = nCheckpoints;
+            co.resume = resume;
+            co.log = note;
+            checkpointDir = workDir;
+            res = bakeWithCheckpoints(plan, co);
+        }
+        res.stats.rhoOverhead = rhoOverhead(plan.layout());
+        res.stats.charts = plan.chartStats();
         if (!quiet && tty) std::fprintf(stderr, "\n");
-        if (gCancel) throw Cancelled();
-        writeBake(output, res.data);
+        writeBake(stagedBake, res.data);
+        if (opt.cancel->load()) throw Cancelled();  // a signal during the write: keep nothing
+        outputs.commit();
+        if (nCheckpoints > 1) removeCheckpoints(workDir);
+        res.stats.wallSeconds = std::chrono::duration<double>(Clock::now() - start).count();
 
         const BakeStats& s = res.stats;
         auto pct = [&](size_t k) { return 100.0 * double(k) / double(std::max<size_t>(1, s.paths)); };
@@ -200,8 +297,12 @@ int main(int argc, char** argv) {
         }
         std::printf("  paths       %zu (%d directions), rays %zu (%.2f per path)\n", s.paths,
                     opt.grid.count(), s.rays, double(s.rays) / std::max<size_t>(1, s.paths));
-        std::printf("  time        %.1f s wall (trace %.1f s, compress %.1f s thread time), %.2f Mrays/s\n",
-                    s.wallSeconds, s.traceSeconds, s.compressSeconds, s.rays / s.wallSeconds * 1e-6);
+        if (nCheckpoints <= 1)
+            std::printf("  time        %.1f s wall (trace %.1f s, compress %.1f s thread time), %.2f Mrays/s\n",
+                        s.wallSeconds, s.traceSeconds, s.compressSeconds, s.rays / s.wallSeconds * 1e-6);
+        else
+            std::printf("  time        %.1f s wall, %d checkpoints (%.1f s of slices in all runs)\n",
+                        s.wallSeconds, nCheckpoints, res.data.manifest["stats"].value("seconds", 0.0));
         std::printf("  paths with  TIR %.2f%%, capped %.3f%% (soft %.3f%%), left and re-entered %.2f%%, "
                     "geometric-normal fallback %.3f%%, leaked %.3f%%\n",
                     pct(s.tir), pct(s.capped), pct(s.softCapped), pct(s.reentered), pct(s.geometricNormal),
@@ -209,15 +310,12 @@ int main(int argc, char** argv) {
         std::printf("  file        %.1f MB, order %d, %d coefficients, %s\n",
                     std::filesystem::file_size(output) / 1e6, opt.order, res.data.coefficientCount(),
                     precision.c_str());
-        return 0;
-    } catch (const Cancelled&) {
-        std::fprintf(stderr, "\nshrefract-bake: cancelled; no file written\n");
-        return 130;
-    } catch (const InputError& e) {
-        std::fprintf(stderr, "shrefract-bake: error: %s\n", e.what());
-        return 2;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "shrefract-bake: error: %s\n", e.what());
-        return 1;
-    }
+        return int(cli::kOk);
+      } catch (const Cancelled&) {
+        if (!checkpointDir.empty())
+            std::fprintf(stderr, "\n%s: finished checkpoints stay in %s: run the same command with "
+                                 "--resume to continue\n", kTool, checkpointDir.c_str());
+        throw;
+      }
+    });
 }

@@ -18,6 +18,8 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "common/cli/cli.h"
+#include "common/output.h"
 #include "shadergen.h"
 #include "sh_form_error.h"
 #include "shrefract/context.h"
@@ -54,9 +56,7 @@ int main(int argc, char** argv) {
     app.add_option("--backend", backend, "egl | osmesa");
     app.add_option("--preset", preset, "shader limits: modern | 2006");
     app.add_option("--json", jsonPath, "write the results here");
-    CLI11_PARSE(app, argc, argv);
-
-    try {
+    return cli::run(app, "shrefract-bench-shforms", argc, argv, [&] {
         auto context = createHeadlessContext(parseBackend(backend));
         nlohmann::json out;
         out["renderer"] = context->description();
@@ -121,14 +121,7 @@ int main(int argc, char** argv) {
                 std::fflush(stdout);
             }
         }
-        if (!jsonPath.empty()) {
-            std::ofstream f(jsonPath);
-            f << out.dump(2) << "\n";
-            if (!f) throw std::runtime_error(jsonPath + ": cannot write");
-        }
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "shrefract-bench-shforms: %s\n", e.what());
-        return 1;
-    }
-    return 0;
+        if (!jsonPath.empty()) writeFile(jsonPath, out.dump(2) + "\n");
+        return cli::kOk;
+    });
 }

@@ -14,8 +14,10 @@
 #include "bake/fit.h"
 #include "bake/layout.h"
 #include "bake/tracer.h"
+#include "common/cli/cli.h"
 #include "common/direction_grid.h"
 #include "common/frame.h"
+#include "common/output.h"
 #include "common/scene.h"
 #include "common/sh.h"
 #include "eval/directions.h"
@@ -63,8 +65,9 @@ int main(int argc, char** argv) {
     app.add_option("--branch", branch)->capture_default_str()->check(CLI::IsMember({"fresnel", "transmit"}));
     app.add_option("--seed", seed)->capture_default_str();
     app.add_option("--json", jsonPath, "write every number here");
-    CLI11_PARSE(app, argc, argv);
-    try {
+    return cli::run(app, "shrefract-fit-study", argc, argv, [&] {
+        OutputSet outputs;  // checked before the study, written when it is complete
+        const std::string stagedJson = jsonPath.empty() ? "" : outputs.add(jsonPath);
         Medium medium;
         medium.ior = ior;
         const Scene scene = loadScene(mesh, medium);
@@ -170,10 +173,8 @@ int main(int argc, char** argv) {
             report["variants"].push_back({{"name", v.name}, {"weighting", v.weighting.ToString()},
                                           {"all", all}, {"plain", plain}, {"chaotic", chaotic}});
         }
-        if (!jsonPath.empty()) std::ofstream(jsonPath) << report.dump(1) << "\n";
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "shrefract-fit-study: %s\n", e.what());
-        return 1;
-    }
-    return 0;
+        if (!jsonPath.empty()) writeFile(stagedJson, report.dump(1) + "\n");
+        outputs.commit();
+        return cli::kOk;
+    });
 }

@@ -3,16 +3,20 @@
 //   query BAKE --in Q.csv --out A.csv                        exit direction per (point, view)
 //   image --ref A.exr --test B.exr [--heatmap H.png] [--json R.json]   two evaluation buffers
 //   montage --out M.png IMG.exr... [--labels L...] [--errors]        labelled side by side
+//   compose R.exr G.exr B.exr --out D.exr    colour channel c of input c (dispersion)
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 
 #include "eval/directions.h"
 #include "eval/image_eval.h"
+#include "eval/reference.h"
+#include "common/cli/cli.h"
 #include "common/error.h"
+#include "common/output.h"
+#include "common/query.h"
 #include "common/sh.h"
 
 using namespace shrefract;
@@ -52,19 +56,20 @@ void printTable(const nlohmann::json& r) {
     row("capped", r["capped"]);
 }
 
-// Writes text to path via a temporary file and a rename: never a half-written report.
-void writeAtomically(const std::string& path, const std::string& text) {
-    std::string tmp = path + ".tmp";
-    {
-        std::ofstream f(tmp);
-        if (!f) throw inputError(path, "cannot write");
-        f << text;
-        if (!f) throw inputError(path, "write failed");
+// "0.5,1,2" -> numbers, each finite and > 0.
+std::vector<double> parseTolerances(const std::string& text) {
+    std::vector<double> v;
+    std::stringstream ss(text);
+    for (std::string t; std::getline(ss, t, ',');) {
+        char* end = nullptr;
+        const double x = std::strtod(t.c_str(), &end);
+        if (t.empty() || *end != '\0' || !std::isfinite(x) || x <= 0)
+            throw std::invalid_argument("--tolerances: '" + text +
+                                        "' is not a list of positive degrees");
+        v.push_back(x);
     }
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-        std::remove(tmp.c_str());
-        throw inputError(path, "cannot write");
-    }
+    if (v.empty()) throw std::invalid_argument("--tolerances: empty");
+    return v;
 }
 
 }  // namespace
@@ -97,6 +102,10 @@ int main(int argc, char** argv) {
     query->add_option("bake", bakePath, "NAME.shrefract.exr")->required();
     query->add_option("--in", inPath, "CSV rows px,py,pz,wx,wy,wz (object space, w toward the viewer)")->required();
     query->add_option("--out", outPath, "CSV rows ex,ey,ez,len")->required();
+    float maxDistance = -1.0f;
+    query->add_option("--max-distance", maxDistance,
+                      "refuse points farther than this from the surface, object units (default: "
+                      "0.001 of the bake's bounding-box diagonal)");
     std::string refPath, testPath, heatPath, outPng;
     float maxDeg = 30.0f, exposure = 1.0f;
     auto* image = app.add_subcommand("image", "compare two render evaluation buffers (docs/evaluation.md)");
@@ -115,10 +124,19 @@ int main(int argc, char** argv) {
     mont->add_flag("--errors", withErrors, "a second row: angular error heat maps against the first input");
     mont->add_option("--max-deg", maxDeg, "heat map: degrees at the top of the ramp")->capture_default_str();
     mont->add_option("--exposure", exposure, "exposure before the tone map")->capture_default_str();
-    CLI11_PARSE(app, argc, argv);
-
-    try {
+    std::vector<std::string> channels;
+    std::string composed;
+    auto* compose = app.add_subcommand(
+        "compose", "one evaluation buffer from three: colour channel c of input c, coverage and "
+                   "directions of the second (three grey renders at one index per channel)");
+    compose->add_option("inputs", channels, "R.exr G.exr B.exr")->required()->expected(3);
+    compose->add_option("--out", composed, "evaluation buffer EXR")->required();
+    return cli::run(app, "shrefract-eval", argc, argv, [&] {
+        // Every output checked and staged before the work (common/output.h).
+        OutputSet outputs;
+        const std::string stagedJson = jsonPath.empty() ? "" : outputs.add(jsonPath);
         if (image->parsed()) {
+            const std::string stagedHeat = heatPath.empty() ? "" : outputs.add(heatPath);
             EvalBuffer ref = readEvalBuffer(refPath), test = readEvalBuffer(testPath);
             nlohmann::json r = compareImages(ref, test, exposure);
             r["ref"] = refPath;
@@ -135,11 +153,22 @@ int main(int argc, char** argv) {
                         r["coverage"]["mismatch"].get<size_t>(), r["coverage"]["refOnly"].get<size_t>(),
                         r["coverage"]["testOnly"].get<size_t>());
             std::printf("tone-mapped: PSNR %.2f dB, SSIM %.4f\n", r["psnr"].get<double>(), r["ssim"].get<double>());
-            if (!heatPath.empty()) writePng8(heatPath, heatMap(ref, test, maxDeg, exposure));
-            if (!jsonPath.empty()) writeAtomically(jsonPath, r.dump(2) + "\n");
-            return 0;
+            if (!heatPath.empty()) writePng8(stagedHeat, heatMap(ref, test, maxDeg, exposure));
+            if (!jsonPath.empty()) writeFile(stagedJson, r.dump(2) + "\n");
+            outputs.commit();
+            return cli::kOk;
+        }
+        if (compose->parsed()) {
+            const std::string stagedOut = outputs.add(composed);
+            writeEvalBuffer(stagedOut, composeChannels(readEvalBuffer(channels[0]),
+                                                      readEvalBuffer(channels[1]),
+                                                      readEvalBuffer(channels[2])));
+            outputs.commit();
+            std::printf("composed -> %s\n", composed.c_str());
+            return int(cli::kOk);
         }
         if (mont->parsed()) {
+            const std::string stagedPng = outputs.add(outPng);
             if (!labels.empty() && labels.size() != inputs.size())
                 throw InputError("montage: " + std::to_string(labels.size()) + " labels for " +
                                  std::to_string(inputs.size()) + " inputs");
@@ -161,15 +190,23 @@ int main(int argc, char** argv) {
                     std::snprintf(line, sizeof line, "no overlap");
                 text[1].push_back(line);
             }
-            writePng8(outPng, montage(rows, text, 2));
+            writePng8(stagedPng, montage(rows, text, 2));
+            outputs.commit();
             std::printf("montage of %zu -> %s\n", buffers.size(), outPng.c_str());
-            return 0;
+            return cli::kOk;
         }
+        const std::string stagedCsv = query->parsed() ? outputs.add(outPath) : "";
+        const std::vector<double> tolerances =
+            adaptive->parsed() ? parseTolerances(tolText) : std::vector<double>();
         ReadOptions readOptions;
         readOptions.verify = !noVerify;
         BakeData bake = readBake(bakePath, readOptions);
         for (const std::string& w : bake.warnings)
             std::fprintf(stderr, "shrefract-eval: warning: %s: %s\n", bakePath.c_str(), w.c_str());
+        if (order < -1 || order > bake.order)
+            throw std::invalid_argument("--order " + std::to_string(order) + ": " + bakePath +
+                                        " stores orders 0.." + std::to_string(bake.order) +
+                                        " (-1: all)");
         if (adaptive->parsed()) {
             Scene scene = sceneOfBake(bake, bakePath, scenePath);
             const size_t n = bake.layout.position.size();
@@ -180,9 +217,7 @@ int main(int argc, char** argv) {
             std::printf("per-sample adaptive order (bake order %d): full-order error median %.2f, p95 %.1f deg\n",
                         bake.order, full["angleDeg"]["median"].get<double>(), full["angleDeg"]["p95"].get<double>());
             std::printf("  %9s  %12s  %14s  %10s  %8s\n", "tolerance", "mean order", "weights kept", "median", "p95");
-            std::stringstream ss(tolText);
-            for (std::string t; std::getline(ss, t, ',');) {
-                const double tol = std::stod(t);
+            for (const double tol : tolerances) {
                 std::vector<int> orders = adaptiveOrders(bake, tol);
                 double kept = 0, meanOrder = 0;
                 for (int o : orders) kept += shEvenCount(o), meanOrder += o;
@@ -195,49 +230,32 @@ int main(int argc, char** argv) {
                                                 {"weightsKept", kept}, {"median", r["angleDeg"]["median"]},
                                                 {"p95", r["angleDeg"]["p95"]}});
             }
-            if (!jsonPath.empty()) writeAtomically(jsonPath, report.dump(2) + "\n");
+            if (!jsonPath.empty()) writeFile(stagedJson, report.dump(2) + "\n");
         } else if (dirs->parsed()) {
             Scene scene = sceneOfBake(bake, bakePath, scenePath);
             nlohmann::json report = evaluateDirections(bake, scene, pairs, seed, order);
             report["bake"] = bakePath;
             printTable(report);
-            if (!jsonPath.empty()) writeAtomically(jsonPath, report.dump(2) + "\n");
+            if (!jsonPath.empty()) writeFile(stagedJson, report.dump(2) + "\n");
         } else {
-            std::ifstream in(inPath);
-            if (!in) throw inputError(inPath, "file not found");
+            const std::vector<Query> queries = readQueries(inPath);
             std::vector<glm::vec3> p, w;
-            std::string line;
-            int lineNo = 0;
-            while (std::getline(in, line)) {
-                ++lineNo;
-                if (line.empty() || line[0] == '#') continue;
-                if (lineNo == 1 && line.find_first_of("0123456789") > line.find_first_of("pxw")) continue;  // header
-                std::replace(line.begin(), line.end(), ',', ' ');
-                std::istringstream ss(line);
-                float v[6];
-                for (float& x : v)
-                    if (!(ss >> x) || !std::isfinite(x))
-                        throw inputError(inPath, "line " + std::to_string(lineNo) + ": expected 6 numbers px,py,pz,wx,wy,wz");
-                glm::vec3 dir(v[3], v[4], v[5]);
-                if (glm::length(dir) < 1e-6f)
-                    throw inputError(inPath, "line " + std::to_string(lineNo) + ": zero view direction");
-                p.emplace_back(v[0], v[1], v[2]);
-                w.push_back(dir);
+            for (const Query& q : queries) p.push_back(q.point), w.push_back(q.view);
+            std::vector<glm::vec4> a;
+            try {
+                a = queryBake(bake, p, w, maxDistance);
+            } catch (const QueryRefused& e) {
+                throw inputError(inPath, "line " + std::to_string(queries[e.index].line) + ": " +
+                                             e.what());
             }
-            std::vector<glm::vec4> a = queryBake(bake, p, w);
             std::ostringstream os;
             os.precision(9);
             os << "ex,ey,ez,len\n";
             for (const glm::vec4& x : a) os << x.x << ',' << x.y << ',' << x.z << ',' << x.w << '\n';
-            writeAtomically(outPath, os.str());
+            writeFile(stagedCsv, os.str());
             std::printf("answered %zu queries -> %s\n", a.size(), outPath.c_str());
         }
-        return 0;
-    } catch (const InputError& e) {
-        std::fprintf(stderr, "shrefract-eval: error: %s\n", e.what());
-        return 2;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "shrefract-eval: error: %s\n", e.what());
-        return 1;
-    }
+        outputs.commit();
+        return cli::kOk;
+    });
 }

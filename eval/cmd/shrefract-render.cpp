@@ -1,32 +1,34 @@
-// shrefract-render: renders a bake in front of an environment, headless (EGL or OSMesa).
-//   shrefract-render BAKE --env ENV.exr [--camera orbit:AZ,EL,DIST | --eye x,y,z --target x,y,z]
-//                    [--fov deg] [--size WxH] [--order L] [--backend egl|osmesa] [--out IMG.png]
-//                    [--out-exr IMG.exr] [--dirs EVAL.exr] [--dump-shaders DIR]
-//                    [--method sh|single|wyman|raytrace] [--wyman-tir reflect|straight|grazing]
+// shrefract-render: renders a bake in front of an environment, headless (EGL or OSMesa), with the
+// SH runtime, a baseline or the ray-traced reference (README "shrefract-render").
 // A thin shell over the runtime library (shrefract/render.h, shrefract/baselines.h) and, for
 // raytrace and Wyman's d_N, the evaluation layer (eval/reference.h, Embree through bake/): the
-// runtime library itself never links the bake. Bad input: message, exit 1, and no output file.
+// runtime library itself never links the bake. Every output is checked before the render and
+// written only when all succeed (common/output.h); exit codes as every tool's (README).
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
-#include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
+#include "common/cli/cli.h"
 #include "common/error.h"
 #include "common/evalbuffer.h"
+#include "common/output.h"
+#include "common/tonemap.h"
+#include "eval/directions.h"
+#include "eval/reference.h"
 #include "shrefract/baselines.h"
 #include "shrefract/context.h"
 #include "shrefract/render.h"
 #include "shrefract/runtime.h"
-
-#include "common/decompress.h"
-#include "eval/directions.h"
-#include "eval/reference.h"
 #include "eval/seams.h"
 
 namespace {
+
+using namespace shrefract;
 
 double medianOf(std::vector<double> v) {
     std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
@@ -52,6 +54,24 @@ std::vector<float> parseFloats(const std::string& text, size_t count, const std:
     return v;
 }
 
+// One method, set up once: renders a camera's frame and says how long it took.
+struct Method {
+    std::function<RenderedFrame(const Camera&, double* ms)> render;
+    std::string timing;  // what its ms are
+};
+
+// Mean absolute difference of the tone-mapped colours of two frames (all pixels, RGB in [0, 1]).
+double meanAbsDifference(const RenderedFrame& a, const RenderedFrame& b, float exposure) {
+    double sum = 0;
+    const size_t n = a.color.size() / 4;
+    for (size_t i = 0; i < n; ++i) {
+        const glm::vec3 x = toneMapAces(glm::vec3(a.color[4 * i], a.color[4 * i + 1], a.color[4 * i + 2]), exposure);
+        const glm::vec3 y = toneMapAces(glm::vec3(b.color[4 * i], b.color[4 * i + 1], b.color[4 * i + 2]), exposure);
+        sum += std::abs(x.r - y.r) + std::abs(x.g - y.g) + std::abs(x.b - y.b);
+    }
+    return sum / (3.0 * std::max<size_t>(1, n));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -61,8 +81,10 @@ int main(int argc, char** argv) {
     float fov = 45.0f, exposure = 1.0f;
     int order = -1, frames = 5, spp = 1;
     bool smoothing = false;
-    std::string method = "sh", wymanTir = "reflect", scenePath;
+    std::string method = "sh", wymanTir = "reflect", scenePath, absorption, flicker, flickerJson;
     bool latLongLookup = false, noVerify = false;
+    std::string iorText, bracketPath;
+    RefractorOptions sh;  // defaults shown in --help
     app.add_option("bake", bakePath, "NAME.shrefract.exr from shrefract-bake")->required();
     app.add_option("--env", envPath, "lat-long environment EXR")->required();
     app.add_option("--camera", camera, "orbit:AZ,EL,DIST (degrees, degrees, object units)");
@@ -73,6 +95,21 @@ int main(int argc, char** argv) {
     app.add_option("--order", order, "SH order used at runtime (default: all stored)");
     app.add_option("--backend", backend, "headless GL: egl | osmesa")->capture_default_str();
     app.add_option("--preset", preset, "shader limits: modern | 2006")->capture_default_str();
+    app.add_option("--path", sh.path, "sh: interpolation, direct | rho | auto (direct for modern, rho for 2006)")
+        ->capture_default_str()->check(CLI::IsMember({"direct", "rho", "auto"}));
+    app.add_option("--decompression", sh.decompression, "sh, direct path: vertex | texture | auto")
+        ->capture_default_str()->check(CLI::IsMember({"vertex", "texture", "auto"}));
+    app.add_option("--shading", sh.shading,
+                   "sh: spread (lobes from the SH length and the pixel footprint) | sharp (the paper's lookup)")
+        ->capture_default_str()->check(CLI::IsMember({"spread", "sharp"}));
+    app.add_option("--spread-scale", sh.spreadScale, "sh, spread shading: lobe width factor")
+        ->capture_default_str()->check(CLI::Range(0.0f, 100.0f));
+    app.add_option("--spread-full", sh.spreadFull,
+                   "sh, spread shading: reconstruction length counted as fully coherent")
+        ->capture_default_str()->check(CLI::Range(0.1f, 2.0f));
+    app.add_option("--footprint-scale", sh.footprintScale, "sh, spread shading: screen footprint factor")
+        ->capture_default_str()->check(CLI::Range(0.0f, 100.0f));
+    app.add_flag("--half-weights", sh.halfWeights, "sh: upload float32 weights as RGBA16F");
     app.add_option("--form", form, "SH evaluation in GLSL: auto | polynomial | recurrence")
         ->capture_default_str()->check(CLI::IsMember({"auto", "polynomial", "recurrence"}));
     app.add_option("--frames", frames, "frames timed after a warm-up one")->capture_default_str();
@@ -90,12 +127,16 @@ int main(int argc, char** argv) {
                    "chart layouts: gutter texels at smooth seams take the values across the cut")
         ->capture_default_str()->check(CLI::IsMember({"on", "off"}));
     app.add_option("--exposure", exposure, "exposure before the tone map")->capture_default_str();
+    app.add_option("--absorption", absorption,
+                   "kappa r,g,b per object-space unit for every method, instead of the bake's media "
+                   "(tinted glass without re-baking: the paths do not depend on it)");
     app.add_option("--out", out, "tone-mapped PNG");
     app.add_option("--out-exr", outExr, "linear HDR RGBA EXR");
     app.add_option("--dirs", dirs,
                    "evaluation buffer EXR: R,G,B colour, A coverage, dir.X/Y/Z world exit "
                    "direction (docs/format.md)");
-    app.add_option("--method", method, "sh | single | wyman | raytrace")->capture_default_str();
+    app.add_option("--method", method, "sh | single | wyman | raytrace")->capture_default_str()
+        ->check(CLI::IsMember({"sh", "single", "wyman", "raytrace"}));
     app.add_option("--wyman-tir", wymanTir,
                    "Wyman at total internal reflection: reflect | straight | grazing")
         ->capture_default_str();
@@ -104,28 +145,44 @@ int main(int argc, char** argv) {
                  "the runtime's cube map");
     app.add_option("--scene", scenePath,
                    "raytrace, wyman: the baked mesh or scene, if not where the manifest says");
+    app.add_option("--flicker", flicker,
+                   "N:STEP: render N frames orbiting STEP degrees of azimuth apart from --camera and "
+                   "report the mean absolute difference of consecutive tone-mapped frames");
+    app.add_option("--flicker-json", flickerJson, "write the --flicker result here");
     app.add_option("--dump-shaders", dumpDir, "write the generated GLSL into DIR");
+    app.add_option("--ior", iorText,
+                   "index of refraction N, or one per channel R,G,B (dispersion): raytrace traces the "
+                   "scene's first part at it, sh interpolates (docs/runtime.md \"Variable IOR\")");
+    app.add_option("--ior-bracket", bracketPath,
+                   "sh with --ior: a second bake of the same mesh at another index, interpolated "
+                   "with BAKE per channel instead of the straight path");
     std::string seamsOf, seamsJson;
     app.add_option("--seams-of", seamsOf,
                    "a chart bake whose smooth seams to measure the render's jump across "
                    "(default: this bake, if it is one)");
     app.add_option("--seams-json", seamsJson, "write the seam jump statistics here (JSON)");
     app.add_flag("--no-verify", noVerify, "skip the bake's checksums (faster; a corrupt file may draw garbage)");
-    CLI11_PARSE(app, argc, argv);
-
-    try {
+    return shrefract::cli::run(app, "shrefract-render", argc, argv, [&] {
+        // Outputs first: a path that cannot be written fails before any rendering.
+        shrefract::OutputSet outputs;
+        const std::string stagedPng = out.empty() ? "" : outputs.add(out);
+        const std::string stagedExr = outExr.empty() ? "" : outputs.add(outExr);
+        const std::string stagedDirs = dirs.empty() ? "" : outputs.add(dirs);
+        const std::string stagedFlicker = flickerJson.empty() ? "" : outputs.add(flickerJson);
+        const std::string stagedSeams = seamsJson.empty() ? "" : outputs.add(seamsJson);
         int width = 0, height = 0;
         char x = 0;
         std::istringstream sizeStream(size);
         if (!(sizeStream >> width >> x >> height) || x != 'x' || width < 1 || height < 1 ||
             width > 16384 || height > 16384 || !sizeStream.eof())
             throw std::invalid_argument("--size: expected WxH, got '" + size + "'");
-        shrefract::Camera cam = shrefract::Camera::orbit(30.0f, 20.0f, 3.0f);
+        Camera cam = Camera::orbit(30.0f, 20.0f, 3.0f);
+        std::vector<float> orbit = {30.0f, 20.0f, 3.0f};
         if (!camera.empty()) {
             if (camera.rfind("orbit:", 0) != 0)
                 throw std::invalid_argument("--camera: expected orbit:AZ,EL,DIST, got '" + camera + "'");
-            auto v = parseFloats(camera.substr(6), 3, "--camera");
-            cam = shrefract::Camera::orbit(v[0], v[1], v[2]);
+            orbit = parseFloats(camera.substr(6), 3, "--camera");
+            cam = Camera::orbit(orbit[0], orbit[1], orbit[2]);
         }
         if (!eye.empty() || !target.empty()) {
             if (eye.empty() || target.empty() || !camera.empty())
@@ -135,170 +192,263 @@ int main(int argc, char** argv) {
             cam.target = {t[0], t[1], t[2]};
         }
         cam.fovDegrees = fov;
-        shrefract::Backend be = shrefract::parseBackend(backend);
-
-        if (method != "sh" && method != "single" && method != "wyman" && method != "raytrace")
-            throw std::invalid_argument("--method: expected sh | single | wyman | raytrace, got '" +
-                                        method + "'");
-        const shrefract::WymanTir tir = shrefract::parseWymanTir(wymanTir);
+        int flickerFrames = 0;
+        float flickerStep = 0;
+        if (!flicker.empty()) {
+            char colon = 0;
+            std::istringstream in(flicker);
+            if (!(in >> flickerFrames >> colon >> flickerStep) || colon != ':' || !in.eof() ||
+                flickerFrames < 2 || flickerFrames > 10000 || !std::isfinite(flickerStep))
+                throw std::invalid_argument("--flicker: expected N:STEP with N >= 2, got '" + flicker + "'");
+            if (!eye.empty()) throw std::invalid_argument("--flicker orbits: give --camera orbit:AZ,EL,DIST");
+        }
+        const Backend be = parseBackend(backend);
+        const WymanTir tir = parseWymanTir(wymanTir);
         if (spp > 1 && method != "raytrace")
             throw std::invalid_argument("--spp " + std::to_string(spp) +
                                         ": only --method raytrace takes several samples per pixel");
 
+        glm::vec3 ior(0.0f);  // 0: the bake's own
+        if (!iorText.empty()) {
+            auto v = parseFloats(iorText, iorText.find(',') == std::string::npos ? 1 : 3, "--ior");
+            ior = v.size() == 1 ? glm::vec3(v[0]) : glm::vec3(v[0], v[1], v[2]);
+            if (glm::any(glm::lessThan(ior, glm::vec3(1.0f))) ||
+                glm::any(glm::greaterThan(ior, glm::vec3(5.0f))))
+                throw std::invalid_argument("--ior: every index must lie in [1, 5], got '" +
+                                            iorText + "'");
+            if (method != "sh" && method != "raytrace")
+                throw std::invalid_argument("--ior works with --method sh or raytrace");
+        }
+        if (!bracketPath.empty() && (iorText.empty() || method != "sh"))
+            throw std::invalid_argument("--ior-bracket needs --ior and --method sh");
+
         // Input first (cheap, and the common failure), then the context.
-        shrefract::Bake bake = shrefract::loadBake(bakePath, !noVerify);
+        Bake bake = loadBake(bakePath, !noVerify);
         for (const std::string& w : bake.warnings())
             std::fprintf(stderr, "shrefract-render: warning: %s: %s\n", bakePath.c_str(), w.c_str());
-        shrefract::RenderedFrame frame;
-        frame.width = width;
-        frame.height = height;
-        double msPerFrame = 0;
-        std::string stages;
+        if (order < -1 || order > bake.order())
+            throw std::invalid_argument("--order " + std::to_string(order) + ": " + bakePath +
+                                        " stores orders 0.." + std::to_string(bake.order()) +
+                                        " (-1: all)");
+        std::vector<float> kappa;
+        if (!absorption.empty()) {
+            kappa = parseFloats(absorption, 3, "--absorption");
+            for (float k : kappa)
+                if (!(k >= 0.0f) || !std::isfinite(k))
+                    throw std::invalid_argument("--absorption: kappa must be finite and >= 0, got '" + absorption + "'");
+            BakeData tinted = bake.data();
+            if (!tinted.manifest.contains("media") || tinted.manifest["media"].empty())
+                tinted.manifest["media"] = nlohmann::json::array({nlohmann::json::object()});
+            tinted.manifest["media"][0]["absorption"] = {kappa[0], kappa[1], kappa[2]};
+            bake = makeBake(std::move(tinted));
+        }
 
-        std::unique_ptr<shrefract::Scene> scene;
-        std::unique_ptr<shrefract::Tracer> tracer;
-        std::unique_ptr<shrefract::BakeData> seamBake;  // whose seams to measure across
+        std::unique_ptr<BakeData> seamBake;  // whose seams to measure the render's jump across
         if (!seamsOf.empty())
-            seamBake = std::make_unique<shrefract::BakeData>(shrefract::readBake(seamsOf));
+            seamBake = std::make_unique<BakeData>(readBake(seamsOf));
         else if (bake.data().layout.isChartLayout())
-            seamBake = std::make_unique<shrefract::BakeData>(bake.data());
+            seamBake = std::make_unique<BakeData>(bake.data());
         if (!seamsOf.empty() && !seamBake->layout.isChartLayout())
             throw std::invalid_argument("--seams-of " + seamsOf + ": a joining bake has no seams");
+
+        std::unique_ptr<Scene> scene;
+        std::unique_ptr<Tracer> tracer;
         if (method == "raytrace" || method == "wyman" || seamBake) {
-            scene = std::make_unique<shrefract::Scene>(
-                shrefract::sceneOfBake(bake.data(), bakePath, scenePath));
-            tracer = std::make_unique<shrefract::Tracer>(
-                *scene, shrefract::traceOptionsOfBake(bake.data()));
+            scene = std::make_unique<Scene>(sceneOfBake(bake.data(), bakePath, scenePath));
+            if (!kappa.empty())
+                for (Part& p : scene->parts) p.medium.absorption = {kappa[0], kappa[1], kappa[2]};
+            tracer = std::make_unique<Tracer>(*scene, traceOptionsOfBake(bake.data()));
         }
+
+        // Set the method up once; `render` draws one camera's frame.
+        Method m;
+        std::unique_ptr<ReferenceEnvironment> envImage;
+        std::unique_ptr<HeadlessContext> context;
+        std::unique_ptr<Environment> env;
+        std::unique_ptr<Refractor> refractor, bracket;
+        std::unique_ptr<Baseline> baseline;
         if (method == "raytrace") {
             // The CPU reference: no GL context at all.
-            shrefract::ReferenceEnvironment envImage(shrefract::loadLatLong(envPath), !latLongLookup);
-            shrefract::ReferenceView view;
-            view.eye = cam.eye, view.target = cam.target, view.up = cam.up;
-            view.fovDegrees = cam.fovDegrees, view.width = width, view.height = height;
-            view.spp = spp;
-            shrefract::ReferenceStats stats;
-            shrefract::EvalBuffer b = shrefract::renderReference(*tracer, envImage, view, &stats);
-            frame.color.resize(b.pixelCount() * 4);
-            frame.directions.resize(b.pixelCount() * 4);
-            for (size_t i = 0; i < b.pixelCount(); ++i) {
-                for (int c = 0; c < 3; ++c) {
-                    frame.color[4 * i + c] = b.color[i][c];
-                    frame.directions[4 * i + c] = b.direction[i][c];
+            envImage = std::make_unique<ReferenceEnvironment>(loadLatLong(envPath), !latLongLookup);
+            m.timing = "CPU wall time, Embree, all cores";
+            m.render = [&](const Camera& c, double* ms) {
+                ReferenceView view;
+                view.eye = c.eye, view.target = c.target, view.up = c.up;
+                view.fovDegrees = c.fovDegrees, view.width = width, view.height = height;
+                view.spp = spp;
+                ReferenceStats stats;
+                EvalBuffer b;
+                if (ior.x > 0) {
+                    // The first part (the object of a bare mesh) at each channel's index.
+                    EvalBuffer channel[3];
+                    for (int ch = 0; ch < 3; ++ch) {
+                        if (ch > 0 && ior[ch] == ior[ch - 1]) {
+                            channel[ch] = channel[ch - 1];
+                            continue;
+                        }
+                        Scene sc = *scene;
+                        sc.parts[0].medium.ior = ior[ch];
+                        Tracer t(sc, traceOptionsOfBake(bake.data()));
+                        ReferenceStats st;
+                        channel[ch] = renderReference(t, *envImage, view, &st);
+                        if (ch == 1 || stats.covered == 0) stats = st;
+                    }
+                    b = composeChannels(channel[0], channel[1], channel[2]);
+                } else {
+                    b = renderReference(*tracer, *envImage, view, &stats);
                 }
-                frame.color[4 * i + 3] = 1.0f;
-                frame.directions[4 * i + 3] = b.color[i].a;
-            }
-            msPerFrame = stats.milliseconds;
-            std::printf("raytrace: %zu covered pixels; paths with TIR %zu, capped %zu, re-entered "
-                        "%zu, geometric normal %zu, back-facing first hits %zu\n",
-                        stats.covered, stats.tir, stats.capped, stats.reentered,
-                        stats.geometricNormal, stats.backFacing);
-            stages = "CPU wall time, Embree, all cores";
-        }
-        if (method != "raytrace") {
-            auto context = shrefract::createHeadlessContext(be, width, height);
-            std::printf("GL: %s (%s)\n", context->description().c_str(), shrefract::ToString(be));
-            shrefract::Environment env = shrefract::Environment::loadLatLong(envPath);
+                RenderedFrame f;
+                f.width = width, f.height = height;
+                f.color.resize(b.pixelCount() * 4);
+                f.directions.resize(b.pixelCount() * 4);
+                for (size_t i = 0; i < b.pixelCount(); ++i) {
+                    for (int ch = 0; ch < 3; ++ch) {
+                        f.color[4 * i + ch] = b.color[i][ch];
+                        f.directions[4 * i + ch] = b.direction[i][ch];
+                    }
+                    f.color[4 * i + 3] = 1.0f;
+                    f.directions[4 * i + 3] = b.color[i].a;
+                }
+                *ms = stats.milliseconds;
+                std::printf("raytrace: %zu covered pixels; paths with TIR %zu, capped %zu, re-entered "
+                            "%zu, geometric normal %zu, back-facing first hits %zu\n",
+                            stats.covered, stats.tir, stats.capped, stats.reentered,
+                            stats.geometricNormal, stats.backFacing);
+                return f;
+            };
+        } else {
+            context = createHeadlessContext(be, width, height);
+            std::printf("GL: %s (%s)\n", context->description().c_str(), ToString(be));
+            env = std::make_unique<Environment>(Environment::loadLatLong(envPath));
             if (method == "sh") {
-                shrefract::RefractorOptions options;
+                RefractorOptions options = sh;
                 options.preset = preset;
                 options.form = form;
                 options.order = order;
+                options.maxOrder = order;  // only the bands used go to the GPU (paper Figure 12)
                 options.smoothing = smoothing;
                 options.gutter = gutter;
                 options.seamAware = seamAware == "on";
                 options.loader = context->loader();
-                auto refractor = shrefract::Refractor::create(bake, options);
-                std::printf("bake: order %d, %d samples, %d triangles, %s layout, %s %dx%d; using "
-                            "order %d, %d decompression pass(es), preset %s\n",
+                refractor = Refractor::create(bake, options);
+                if (ior.x > 0) {
+                    refractor->setIor(ior);
+                    if (!bracketPath.empty()) {
+                        bracket = Refractor::create(loadBake(bracketPath, !noVerify), options);
+                        refractor->setIorBracket(bracket.get());
+                    }
+                    std::printf("index of refraction %g,%g,%g from the bake's %g%s\n", ior.x, ior.y,
+                                ior.z, bake.ior(),
+                                bracket ? " and the bracketing bake's" : " and the straight path");
+                }
+                std::printf("bake: order %d, %d samples, %d triangles, rho %dx%d; using order %d, "
+                            "%d decompression pass(es), preset %s, path %s, decompression %s, "
+                            "shading %s; GPU memory %.2f MB\n",
                             bake.order(), bake.sampleCount(), bake.triangleCount(),
                             bake.layout().c_str(), bake.layout() == "joining" ? "rho" : "atlas",
                             refractor->refractionMapSize().x, refractor->refractionMapSize().y,
-                            refractor->order(), refractor->passCount(), preset.c_str());
+                            refractor->order(), refractor->passCount(), preset.c_str(),
+                            refractor->path().c_str(), refractor->decompression().c_str(),
+                            options.shading.c_str(), refractor->memory().total() / 1e6);
                 if (bake.layout() != "joining")
                     std::printf("charts: gutter %d texels, seam-aware %s\n", refractor->gutter(),
                                 refractor->seamAware() ? "on" : "off");
-                const shrefract::GpuMemory& mem = refractor->memory();
-                std::printf("GPU memory: %.3f MB (weights %.3f, samples %.3f, rho/index %.3f, "
-                            "neighbours %.3f, targets %.3f)\n",
-                            mem.total() / 1e6, mem.weights / 1e6, mem.samples / 1e6, mem.rho / 1e6,
-                            mem.neighbours / 1e6, mem.targets / 1e6);
                 if (!dumpDir.empty()) refractor->dumpShaders(dumpDir);
                 if (bake.layout() != "joining") {  // the map's own jump across the seams
                     refractor->update(cam.eye);
-                    const std::vector<float> m = refractor->readRefractionMap();
-                    std::vector<glm::vec4> map(m.size() / 4);
+                    const std::vector<float> mp = refractor->readRefractionMap();
+                    std::vector<glm::vec4> map(mp.size() / 4);
                     for (size_t i = 0; i < map.size(); ++i)
-                        map[i] = {m[4 * i], m[4 * i + 1], m[4 * i + 2], m[4 * i + 3]};
-                    nlohmann::json st = shrefract::jumpStats(
-                        {}, shrefract::seamJumps(bake.data().layout, map));
+                        map[i] = {mp[4 * i], mp[4 * i + 1], mp[4 * i + 2], mp[4 * i + 3]};
+                    nlohmann::json st = jumpStats({}, seamJumps(bake.data().layout, map));
                     if (st["count"].get<size_t>() > 0)
                         std::printf("refraction map across %zu smooth seam points: jump median %.3f, "
                                     "p95 %.3f deg\n",
                                     st["count"].get<size_t>(), st["median"].get<double>(),
                                     st["p95"].get<double>());
                 }
-
-                // A first frame warms up shader compilation (llvmpipe JIT-compiles at first
-                // draw); the timings printed are the per-stage medians of the `frames` frames
-                // after it.
-                shrefract::renderFrame(*refractor, env, cam, width, height);
-                std::vector<shrefract::Timings> all;
-                for (int f = 0; f < std::max(1, frames); ++f) {
-                    frame = shrefract::renderFrame(*refractor, env, cam, width, height);
-                    all.push_back(frame.timings);
-                }
-                auto median = [&](double shrefract::Timings::*field) {
-                    std::vector<double> v;
-                    for (const auto& x : all) v.push_back(x.*field);
-                    return medianOf(v);
+                m.timing = "GPU, sum of the stages";
+                m.render = [&](const Camera& c, double* ms) {
+                    RenderedFrame f = renderFrame(*refractor, *env, c, width, height);
+                    const Timings& t = f.timings;
+                    *ms = t.view + t.decompress + t.smooth + t.unpack + t.shade;
+                    return f;
                 };
-                shrefract::Timings t = frame.timings;
-                t.view = median(&shrefract::Timings::view);
-                t.decompress = median(&shrefract::Timings::decompress);
-                t.smooth = median(&shrefract::Timings::smooth);
-                t.unpack = median(&shrefract::Timings::unpack);
-                t.shade = median(&shrefract::Timings::shade);
-                std::printf("frames: %d timed (median per stage)\n", static_cast<int>(all.size()));
-                std::printf("GPU ms: view %.3f, decompress %.3f (%d passes), smooth %.3f, unpack "
-                            "%.3f, shade %.3f\n",
-                            t.view, t.decompress, t.passes, t.smooth, t.unpack, t.shade);
-                std::vector<double> totals;
-                for (const auto& x : all)
-                    totals.push_back(x.view + x.decompress + x.smooth + x.unpack + x.shade);
-                msPerFrame = medianOf(totals);
-                stages = "GPU, sum of the stages";
             } else {
-                shrefract::BaselineOptions options;
-                options.method = shrefract::parseBaselineMethod(method);
+                BaselineOptions options;
+                options.method = parseBaselineMethod(method);
                 options.tir = tir;
                 options.loader = context->loader();
                 std::vector<float> normalDistance;
-                if (tracer) normalDistance = shrefract::normalDistances(*tracer, bake.data().layout);
-                auto baseline = shrefract::Baseline::create(bake, normalDistance, options);
-                shrefract::renderFrame(*baseline, env, cam, width, height);  // warm-up
-                std::vector<double> back, shade, totals;
-                for (int f = 0; f < std::max(1, frames); ++f) {
-                    frame = shrefract::renderFrame(*baseline, env, cam, width, height);
-                    const shrefract::BaselineTimings& t = baseline->timings();
-                    back.push_back(t.backFaces);
-                    shade.push_back(t.shade);
-                    totals.push_back(t.backFaces + t.shade);
-                }
-                std::printf("frames: %d timed (median per stage)\n", static_cast<int>(totals.size()));
-                std::printf("GPU ms: back faces %.3f, shade %.3f\n", medianOf(back), medianOf(shade));
-                msPerFrame = medianOf(totals);
-                stages = "GPU, sum of the passes";
+                if (tracer) normalDistance = normalDistances(*tracer, bake.data().layout);
+                baseline = Baseline::create(bake, normalDistance, options);
+                m.timing = "GPU, sum of the passes";
+                m.render = [&](const Camera& c, double* ms) {
+                    RenderedFrame f = renderFrame(*baseline, *env, c, width, height);
+                    *ms = baseline->timings().backFaces + baseline->timings().shade;
+                    return f;
+                };
             }
         }
-        std::printf("ms per frame (%s): %.3f (%s)\n", method.c_str(), msPerFrame, stages.c_str());
+
+        RenderedFrame frame;
+        double msPerFrame = 0;
+        if (flickerFrames > 0) {
+            // A slow orbit: the mean absolute frame-to-frame change (issue 8's flicker ratio is
+            // this over the 64-spp reference's). Frame 0 is the --camera view.
+            std::vector<double> diffs;
+            RenderedFrame previous;
+            double ms = 0;
+            for (int f = 0; f < flickerFrames; ++f) {
+                Camera c = Camera::orbit(orbit[0] + f * flickerStep, orbit[1], orbit[2]);
+                c.fovDegrees = fov;
+                frame = m.render(c, &ms);
+                if (f > 0) diffs.push_back(meanAbsDifference(previous, frame, exposure));
+                previous = frame;
+            }
+            double mean = 0;
+            for (double d : diffs) mean += d;
+            mean /= double(diffs.size());
+            std::printf("flicker: %d frames %g deg apart, mean |frame - previous| = %.6f (tone-mapped)\n",
+                        flickerFrames, flickerStep, mean);
+            if (!flickerJson.empty())
+                writeFile(stagedFlicker,
+                          nlohmann::json{{"method", method}, {"frames", flickerFrames}, {"stepDeg", flickerStep},
+                                         {"meanAbsDifference", mean}, {"differences", diffs}}.dump(1) + "\n");
+            msPerFrame = ms;
+        } else {
+            // A first frame warms up (llvmpipe JIT-compiles shaders at first draw); the time
+            // printed is the median of the `frames` frames after it. The reference is traced once.
+            std::vector<double> times;
+            double ms = 0;
+            if (method != "raytrace") m.render(cam, &ms);
+            for (int f = 0; f < (method == "raytrace" ? 1 : std::max(1, frames)); ++f) {
+                frame = m.render(cam, &ms);
+                times.push_back(ms);
+            }
+            msPerFrame = medianOf(times);
+            if (refractor) {
+                const Timings& t = frame.timings;
+                std::printf("GPU ms: view %.3f, decompress %.3f (%d passes), smooth %.3f, unpack "
+                            "%.3f, shade %.3f\n",
+                            t.view, t.decompress, t.passes, t.smooth, t.unpack, t.shade);
+                if (bracket)
+                    std::printf("GPU memory: %.1f MB + bracketing bake %.1f MB\n",
+                                refractor->memory().total() / 1e6, bracket->memory().total() / 1e6);
+                else
+                    std::printf("GPU memory: %.1f MB\n", refractor->memory().total() / 1e6);
+            } else if (baseline) {
+                std::printf("GPU ms: back faces %.3f, shade %.3f\n", baseline->timings().backFaces,
+                            baseline->timings().shade);
+            }
+        }
+        std::printf("ms per frame (%s): %.3f (%s)\n", method.c_str(), msPerFrame, m.timing.c_str());
         if (seamBake) {
-            shrefract::ReferenceView view;
+            ReferenceView view;
             view.eye = cam.eye, view.target = cam.target, view.up = cam.up;
             view.fovDegrees = cam.fovDegrees, view.width = width, view.height = height;
-            const auto pairs = shrefract::seamPixelPairs(*tracer, seamBake->layout, view);
-            nlohmann::json st = shrefract::jumpStats(pairs, shrefract::pairJumps(frame.directions, pairs));
+            const auto pairs = seamPixelPairs(*tracer, seamBake->layout, view);
+            nlohmann::json st = jumpStats(pairs, pairJumps(frame.directions, pairs));
             if (st["count"].get<size_t>() > 0)
                 std::printf("seams: %zu pixel pairs straddle a smooth seam; exit direction jump mean "
                             "%.3f, median %.3f, p95 %.3f deg\n",
@@ -306,25 +456,17 @@ int main(int argc, char** argv) {
                             st["median"].get<double>(), st["p95"].get<double>());
             else
                 std::printf("seams: no pixel pair straddles a visible smooth seam\n");
-            if (!seamsJson.empty()) {
-                std::ofstream f(seamsJson + ".tmp");
-                f << st.dump(2) << "\n";
-                f.close();
-                if (!f || std::rename((seamsJson + ".tmp").c_str(), seamsJson.c_str()) != 0)
-                    throw std::runtime_error(seamsJson + ": cannot write");
-            }
+            if (!seamsJson.empty()) writeFile(stagedSeams, st.dump(2) + "\n");
         }
         size_t covered = 0;
         for (size_t i = 3; i < frame.directions.size(); i += 4) covered += frame.directions[i] > 0;
         std::printf("coverage: %.1f%% of pixels\n", 100.0 * covered / (size_t(width) * height));
-        if (!out.empty()) shrefract::writePng(out, frame, exposure);
-        if (!outExr.empty()) shrefract::writeExr(outExr, width, height, frame.color);
+        if (!out.empty()) shrefract::writePng(stagedPng, frame, exposure);
+        if (!outExr.empty()) shrefract::writeExr(stagedExr, width, height, frame.color);
         if (!dirs.empty())
             shrefract::writeEvalBuffer(
-                dirs, shrefract::makeEvalBuffer(width, height, frame.color, frame.directions));
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "shrefract-render: %s\n", e.what());
-        return 1;
-    }
-    return 0;
+                stagedDirs, shrefract::makeEvalBuffer(width, height, frame.color, frame.directions));
+        outputs.commit();  // all or none
+        return shrefract::cli::kOk;
+    });
 }

@@ -22,6 +22,8 @@
 
 #include "gl.h"  // the runtime's loader: the viewer needs a handful of GL calls of its own
 #include "common/bakefile.h"
+#include "common/cli/cli.h"
+#include "common/output.h"
 #include "common/png.h"
 #include "shrefract/baselines.h"
 #include "shrefract/render.h"
@@ -59,7 +61,7 @@ void saveScreenshot(const std::string& path, int w, int h) {
     for (int y = 0; y < h; ++y)
         std::copy_n(&rows[(h - 1 - y) * stride], stride, &flipped[y * stride]);
     shrefract::writePngRgb8(path, w, h, flipped.data());
-    std::printf("saved %s (%dx%d)\n", path.c_str(), w, h);
+    std::printf("saved %s (%dx%d)\n", shrefract::outputName(path).c_str(), w, h);
 }
 
 Viewer& state(GLFWwindow* window) { return *static_cast<Viewer*>(glfwGetWindowUserPointer(window)); }
@@ -131,44 +133,47 @@ int main(int argc, char** argv) {
     std::string startMethod = "sh";
     app.add_option("--method", startMethod, "method at start (M cycles): sh | single | wyman")
         ->capture_default_str();
-    CLI11_PARSE(app, argc, argv);
+    return shrefract::cli::run(app, "shrefract-view", argc, argv, [&] {
+        // The final screenshot is checked and staged before any window opens (common/output.h).
+        shrefract::OutputSet outputs;
+        const std::string stagedShot = screenshotPath.empty() ? "" : outputs.add(screenshotPath);
+        int width = 0, height = 0;
+        char x = 0;
+        std::istringstream sizeStream(size);
+        if (!(sizeStream >> width >> x >> height) || x != 'x' || width < 16 || height < 16)
+            throw std::invalid_argument("--size: expected WxH (at least 16x16), got '" + size + "'");
+        if (!screenshotPath.empty() && frames <= 0) frames = 1;
 
-    int width = 0, height = 0;
-    char x = 0;
-    std::istringstream sizeStream(size);
-    if (!(sizeStream >> width >> x >> height) || x != 'x' || width < 16 || height < 16) {
-        std::fprintf(stderr, "shrefract-view: --size: expected WxH, got '%s'\n", size.c_str());
-        return 1;
-    }
-    if (!screenshotPath.empty() && frames <= 0) frames = 1;
+        glfwSetErrorCallback(onGlfwError);
+        if (!glfwInit()) throw std::runtime_error("cannot initialise GLFW (no display?)");
+        // Closes the window and GLFW on every way out, after the GL objects declared below.
+        struct Glfw {
+            GLFWwindow* window = nullptr;
+            ~Glfw() {
+                if (window) glfwDestroyWindow(window);
+                glfwTerminate();
+            }
+        } glfw;
+        glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+        glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+        glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+        glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+        glfwWindowHint(GLFW_DEPTH_BITS, 24);
+        GLFWwindow* window = glfw.window = glfwCreateWindow(width, height, "shrefract-view", nullptr, nullptr);
+        if (!window) throw std::runtime_error("cannot open a window with OpenGL 3.3 core");
+        glfwMakeContextCurrent(window);
+        glfwSwapInterval(frames > 0 ? 0 : 1);
 
-    glfwSetErrorCallback(onGlfwError);
-    if (!glfwInit()) {
-        std::fprintf(stderr, "shrefract-view: cannot initialise GLFW (no display?)\n");
-        return 1;
-    }
-    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
-    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
-    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
-    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
-    glfwWindowHint(GLFW_DEPTH_BITS, 24);
-    GLFWwindow* window = glfwCreateWindow(width, height, "shrefract-view", nullptr, nullptr);
-    if (!window) {
-        std::fprintf(stderr, "shrefract-view: cannot open a window with OpenGL 3.3 core\n");
-        glfwTerminate();
-        return 1;
-    }
-    glfwMakeContextCurrent(window);
-    glfwSwapInterval(frames > 0 ? 0 : 1);
-
-    int status = 0;
-    try {
         ensureLoaded(reinterpret_cast<Loader>(&glfwGetProcAddress));
         std::printf("GL: %s, %s\n", reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
                     reinterpret_cast<const char*>(glGetString(GL_VERSION)));
         shrefract::Bake bake = shrefract::loadBake(bakePath, !noVerify);
         for (const std::string& w : bake.warnings())
             std::fprintf(stderr, "shrefract-view: warning: %s: %s\n", bakePath.c_str(), w.c_str());
+        if (order < -1 || order > bake.order())
+            throw std::invalid_argument("--order " + std::to_string(order) + ": " + bakePath +
+                                        " stores orders 0.." + std::to_string(bake.order()) +
+                                        " (-1: all)");
         shrefract::Environment env = shrefract::Environment::loadLatLong(envPath);
         shrefract::RefractorOptions options;
         options.preset = preset;
@@ -256,10 +261,10 @@ int main(int argc, char** argv) {
             const bool last_frame = frames > 0 && frame >= frames;
             if (v.screenshot || (last_frame && !screenshotPath.empty())) {
                 glFinish();
-                std::string path = last_frame && !screenshotPath.empty()
-                                       ? screenshotPath
-                                       : "shrefract-view-" + std::to_string(shots++) + ".png";
-                saveScreenshot(path, fbw, fbh);
+                const bool final = last_frame && !screenshotPath.empty();
+                saveScreenshot(final ? stagedShot : "shrefract-view-" + std::to_string(shots++) + ".png",
+                               fbw, fbh);
+                if (final) outputs.commit();
                 v.screenshot = false;
             }
             glfwSwapBuffers(window);
@@ -268,18 +273,26 @@ int main(int argc, char** argv) {
             auto now = Clock::now();
             frameMs = std::chrono::duration<double, std::milli>(now - last).count();
             last = now;
-            const shrefract::Timings& t = refractor->timings();
-            char chartState[64] = "";
-            if (charts)
-                std::snprintf(chartState, sizeof chartState, " gutter %d seam-aware %s",
-                              refractor->gutter(), refractor->seamAware() ? "on" : "off");
             char title[320];
-            std::snprintf(title, sizeof title,
-                          "shrefract-view | %s order %d (%d pass) smooth %s%s | %.1f ms/frame | "
-                          "view %.2f dec %.2f smooth %.2f %s %.2f shade %.2f ms",
-                          kMethods[v.method], refractor->order(), refractor->passCount(),
-                          v.smoothing ? "on" : "off", chartState, frameMs, t.view, t.decompress,
-                          t.smooth, charts ? "gutters" : "unpack", t.unpack, t.shade);
+            if (sh) {
+                const shrefract::Timings& t = refractor->timings();
+                char chartState[64] = "";
+                if (charts)
+                    std::snprintf(chartState, sizeof chartState, " gutter %d seam-aware %s",
+                                  refractor->gutter(), refractor->seamAware() ? "on" : "off");
+                std::snprintf(title, sizeof title,
+                              "shrefract-view | sh order %d (%s, %d pass) smooth %s%s | %.1f ms/frame | "
+                              "view %.2f dec %.2f smooth %.2f %s %.2f shade %.2f ms",
+                              refractor->order(), refractor->path().c_str(), refractor->passCount(),
+                              v.smoothing ? "on" : "off", chartState, frameMs, t.view, t.decompress,
+                              t.smooth, charts ? "gutters" : "unpack", t.unpack, t.shade);
+            } else {
+                // The baselines have no SH order and no SH stages: only their own passes.
+                const shrefract::BaselineTimings& t = baselines[v.method - 1]->timings();
+                std::snprintf(title, sizeof title,
+                              "shrefract-view | %s | %.1f ms/frame | back faces %.2f shade %.2f ms",
+                              kMethods[v.method], frameMs, t.backFaces, t.shade);
+            }
             glfwSetWindowTitle(window, title);
             if (now - lastReport > std::chrono::seconds(1) || last_frame) {
                 // Stdout gets the title without its "shrefract-view | " prefix.
@@ -289,11 +302,6 @@ int main(int argc, char** argv) {
             }
             if (last_frame) break;
         }
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "shrefract-view: %s\n", e.what());
-        status = 1;
-    }
-    glfwDestroyWindow(window);
-    glfwTerminate();
-    return status;
+        return shrefract::cli::kOk;
+    });
 }

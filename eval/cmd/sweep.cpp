@@ -15,13 +15,16 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
 
 #include "bake/bake.h"
 #include "gl.h"  // glFinish, through the runtime's loader
 #include "eval/image_eval.h"
 #include "bake/layout.h"
 #include "eval/reference.h"
+#include "common/cli/cli.h"
 #include "common/latlong.h"
+#include "common/output.h"
 #include "common/sh.h"
 #include "shrefract/baselines.h"
 #include "shrefract/context.h"
@@ -77,9 +80,15 @@ int main(int argc, char** argv) {
     app.add_flag("--table1", table1,
                  "instead: one row of the paper's Table 1 (order 8, 32x64, --samples 35000, "
                  "1350x1100) into --json");
-    CLI11_PARSE(app, argc, argv);
-
-    try {
+    std::string bakePath;
+    app.add_option("--bake", bakePath,
+                   "with --table1: render this bake of --mesh instead of baking (its manifest "
+                   "gives samples, rays and bake seconds)");
+    return cli::run(app, "shrefract-sweep", argc, argv, [&] {
+        // The outputs are checked before hours of work, and written only when all succeed.
+        OutputSet outputs;
+        const std::string stagedJson = outputs.add(jsonPath);
+        const std::string stagedCsv = csvPath.empty() ? "" : outputs.add(csvPath);
         Medium medium;
         medium.ior = ior;
         Scene scene = loadScene(mesh, medium);
@@ -89,8 +98,17 @@ int main(int argc, char** argv) {
         Tracer tracer(scene, TraceOptions{});
 
         if (table1) {
-            BakeOptions bo;  // the paper's settings: order 8, 32 x 64, 35k samples
-            BakeResult res = bake(scene, bo, mesh);
+            BakeResult res;
+            if (bakePath.empty()) {
+                BakeOptions bo;  // the paper's settings: order 8, 32 x 64, 35k samples
+                res = bake(scene, bo, mesh);
+            } else {
+                res.data = readBake(bakePath);
+                const nlohmann::json& st = res.data.manifest["stats"];
+                res.stats.samples = res.data.layout.position.size();
+                res.stats.rays = st.value("rays", size_t(0));
+                res.stats.wallSeconds = st.value("seconds", 0.0);
+            }
             RefractorOptions o;
             o.loader = context->loader();
             o.timings = false;
@@ -119,9 +137,10 @@ int main(int argc, char** argv) {
                                   {"triangles", triangles}, {"muSize", res.data.layout.muWidth},
                                   {"memoryMB", r->memory().total() / 1e6}, {"msFrame", ms[ms.size() / 2]},
                                   {"bakeSeconds", res.stats.wallSeconds}, {"renderer", context->description()}};
-            std::ofstream(jsonPath) << row.dump(2) << "\n";
+            writeFile(stagedJson, row.dump(2) + "\n");
+            outputs.commit();
             std::printf("%s\n", row.dump().c_str());
-            return 0;
+            return cli::kOk;
         }
 
         // Two views around the object, at 2.5 bounding radii.
@@ -316,9 +335,9 @@ int main(int argc, char** argv) {
             j["family"] = p.family, j["label"] = p.label, j["value"] = p.value;
             out["points"].push_back(j);
         }
-        std::ofstream(jsonPath) << out.dump(2) << "\n";
+        writeFile(stagedJson, out.dump(2) + "\n");
         if (!csvPath.empty()) {
-            std::ofstream csv(csvPath);
+            std::ostringstream csv;
             csv << "family,label,value,medianDeg,p95Deg,psnr,ssim,msFrame,memoryMB,bakeSeconds\n";
             for (const Point& p : points) {
                 const auto& m = p.metrics;
@@ -327,11 +346,10 @@ int main(int argc, char** argv) {
                     << m.value("msFrame", 0.0) << ',' << m.value("memoryMB", 0.0) << ',' << m.value("bakeSeconds", 0.0)
                     << '\n';
             }
+            writeFile(stagedCsv, csv.str());
         }
+        outputs.commit();
         std::printf("wrote %s (%zu points)\n", jsonPath.c_str(), points.size());
-        return 0;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "shrefract-sweep: error: %s\n", e.what());
-        return 1;
-    }
+        return cli::kOk;
+    });
 }

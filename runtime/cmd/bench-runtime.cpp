@@ -23,6 +23,8 @@
 #include <nlohmann/json.hpp>
 
 #include "common/bakefile.h"
+#include "common/cli/cli.h"
+#include "common/output.h"
 #include "gl.h"
 #include "shrefract/context.h"
 #include "shrefract/baselines.h"
@@ -110,9 +112,7 @@ int main(int argc, char** argv) {
     app.add_option("--smooth", smoothing, "neighbour-list smoothing on (true/false)")
         ->capture_default_str();
     app.add_option("--json", jsonPath, "output file (default: stdout)");
-    CLI11_PARSE(app, argc, argv);
-
-    try {
+    return cli::run(app, "shrefract-bench-runtime", argc, argv, [&] {
         Bake bake = loadBake(bakePath);
         auto context = createHeadlessContext(parseBackend(backend));
         Environment env = Environment::loadLatLong(envPath);
@@ -247,13 +247,8 @@ int main(int argc, char** argv) {
         if (jsonPath.empty()) {
             std::fputs(text.c_str(), stdout);
         } else {
-            std::ofstream file(jsonPath);
-            file << text;
-            if (!file) throw std::runtime_error(jsonPath + ": cannot write");
+            writeFile(jsonPath, text);
         }
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "shrefract-bench-runtime: %s\n", e.what());
-        return 1;
-    }
-    return 0;
+        return cli::kOk;
+    });
 }

@@ -22,6 +22,15 @@ const BakeData& Bake::data() const {
 }
 int Bake::order() const { return data().order; }
 const std::vector<std::string>& Bake::warnings() const { return data().warnings; }
+
+std::vector<MapVertex> Bake::refractionMapMesh() const {
+    // The layout's drawn mesh (common/bakefile.h drawCorners): joining, each triangle's corner
+    // samples (0,0), (r,0), (0,r) at their rho texel centres (docs/format.md "rho"); charts, the
+    // unfolded mesh at its atlas UVs.
+    std::vector<MapVertex> out;
+    for (const DrawCorner& c : drawCorners(data().layout)) out.push_back({c.position, c.normal, c.uv});
+    return out;
+}
 int Bake::sampleCount() const { return data().layout.sampleCount(); }
 int Bake::triangleCount() const { return data().layout.triangleCount; }
 std::string Bake::layout() const { return ToString(data().layout.kind); }

@@ -25,8 +25,8 @@ Environment Environment::loadLatLong(const std::string& path, int faceSize) {
 
 Environment Environment::fromLatLong(int width, int height, const std::vector<float>& rgb,
                                      int faceSize) {
-    if (width < 1 || height < 1 || rgb.size() != static_cast<size_t>(width) * height * 3)
-        throw std::invalid_argument("shrefract: lat-long image size mismatch");
+    const std::string problem = latLongProblem(width, height, rgb);
+    if (!problem.empty()) throw std::invalid_argument("shrefract: Environment::fromLatLong: " + problem);
     ensureLoaded(currentContextLoader());
     Environment env;
     env.faceSize_ = faceSize > 0 ? faceSize : std::max(1, height / 2);

@@ -23,6 +23,7 @@
 #include "common/sh.h"
 #include "environment_gl.h"
 #include "gl.h"
+#include "ior.h"
 #include "shadergen.h"
 #include "shaders.h"
 #include "shrefract/runtime.h"
@@ -111,6 +112,7 @@ struct Refractor::Impl {
     glm::vec3 lastEye{0, 0, 3};  // object space, of the last update()
     // Chart bakes: the isolated-surface pipeline, whose refraction map (the atlas) is `rho`.
     std::unique_ptr<ChartPipeline> charts;
+    IorShading ior;              // setIor(): shading at other indices (runtime/src/ior.h)
 
     void use() const { ensureLoaded(loader); }
     const Compiled& compiledFor(int L);
@@ -223,6 +225,10 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
     const int n = L.sampleCount();
     if (n == 0 || L.muWidth * L.muHeight < n || L.triangleCount == 0)
         throw std::invalid_argument("shrefract: bake has an empty or inconsistent layout");
+    if (options.order < -1 || options.maxOrder < -1)
+        throw std::invalid_argument("shrefract: RefractorOptions order " +
+                                    std::to_string(options.order) + ", maxOrder " +
+                                    std::to_string(options.maxOrder) + ": -1 (all) or 0 and up");
     m->maxOrder = options.maxOrder < 0 ? d.order : std::min(options.maxOrder, d.order);
     m->order = options.order < 0 ? m->maxOrder : std::min(options.order, m->maxOrder);
     m->smoothing = options.smoothing;
@@ -467,25 +473,18 @@ void Refractor::Impl::ensureRhoResources() {
 
 // The rho path's shading (and the chart path's): its program and the mesh, UVs into the map.
 void Refractor::Impl::buildRhoMesh() {
-    const SurfaceLayout& L = bake.data().layout;
     shadeRhoProgram = buildProgram(shaders::source("shade.vert"), shaders::source("shade.frag"), "shading");
     glUseProgram(shadeRhoProgram);
     setInt(shadeRhoProgram, "uRho", 1);
     glUseProgram(0);
-    // The mesh of the layout (common/bakefile.h drawCorners): for joining the triangles' corner
-    // samples with UVs at their texel centres in rho, for charts the unfolded mesh.
-    std::vector<float> vertices;
-    for (const DrawCorner& c : drawCorners(L)) {
-        const float v[8] = {c.position.x, c.position.y, c.position.z, c.normal.x,
-                            c.normal.y,   c.normal.z,   c.uv.x,       c.uv.y};
-        vertices.insert(vertices.end(), v, v + 8);
-    }
-    rhoVertexCount = L.triangleCount * 3;
+    static_assert(sizeof(MapVertex) == 8 * sizeof(float));
+    const std::vector<MapVertex> vertices = bake.refractionMapMesh();
+    rhoVertexCount = static_cast<int>(vertices.size());
     glGenVertexArrays(1, &rhoVao);
     glBindVertexArray(rhoVao);
     glGenBuffers(1, &rhoVbo);
     glBindBuffer(GL_ARRAY_BUFFER, rhoVbo);
-    glBufferData(GL_ARRAY_BUFFER, vertices.size() * sizeof(float), vertices.data(), GL_STATIC_DRAW);
+    glBufferData(GL_ARRAY_BUFFER, vertices.size() * sizeof(MapVertex), vertices.data(), GL_STATIC_DRAW);
     for (int a = 0; a < 3; ++a) glEnableVertexAttribArray(a);
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 8 * sizeof(float), nullptr);
     glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 8 * sizeof(float),
@@ -493,7 +492,7 @@ void Refractor::Impl::buildRhoMesh() {
     glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, 8 * sizeof(float),
                           reinterpret_cast<void*>(6 * sizeof(float)));
     glBindVertexArray(0);
-    memory.mesh = vertices.size() * sizeof(float);
+    memory.mesh = vertices.size() * sizeof(MapVertex);
 }
 
 Refractor::~Refractor() {
@@ -510,6 +509,7 @@ Refractor::~Refractor() {
     for (GLuint p : {m.viewProgram, m.smoothProgram, m.unpackProgram, m.shadeRhoProgram,
                      m.shadeDirectProgram})
         if (p) glDeleteProgram(p);
+    m.ior.destroy();
     GLuint textures[] = {m.positionTex, m.normalTex, m.weightArray, m.rhoIndexTex,
                          m.rangeTex,    m.nbrIndexTex, m.nbrWeightTex};
     for (GLuint t : textures)
@@ -673,6 +673,21 @@ void Refractor::update(glm::vec3 eye, const glm::mat4& model) {
         else if (!m.direct) m.unpackRho(true);
         else if (m.rhoIndexTex) m.unpackRho(false);
     }
+    if (m.ior.active) {
+        // Shading at other indices (runtime/src/ior.h) reads D_mu from a texture on the direct
+        // path, and the bracketing bake's D for the same view; its stages count in this frame's.
+        if (m.direct && m.vertexMode()) m.decompressInTextureSpace(true);
+        if (Refractor* other = m.ior.bracket) {
+            other->update(eye, model);
+            Impl& b = *other->impl_;
+            if (m.direct && b.vertexMode()) b.decompressInTextureSpace(false);
+            m.ior.bracketD = m.direct ? b.lastD : other->refractionMap();
+            m.timings.view += b.timings.view, m.timings.decompress += b.timings.decompress;
+            m.timings.smooth += b.timings.smooth, m.timings.unpack += b.timings.unpack;
+            m.timings.passes += b.timings.passes;
+            m.use();
+        }
+    }
     glUseProgram(0);
     glBindVertexArray(0);
     glActiveTexture(GL_TEXTURE0);
@@ -688,8 +703,10 @@ void Refractor::draw(const glm::mat4& view, const glm::mat4& projection, const g
     m.begin(kShade);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
-    GLuint p = !m.direct          ? m.shadeRhoProgram
-               : m.vertexMode()   ? m.compiledFor(m.order).shadeVertexSh
+    const bool vertexSh = m.vertexMode() && !m.ior.active;
+    GLuint p = m.ior.active       ? m.ior.program(m.direct, m.muW)
+               : !m.direct        ? m.shadeRhoProgram
+               : vertexSh         ? m.compiledFor(m.order).shadeVertexSh
                                   : m.directTextureProgram();
     glUseProgram(p);
     glm::mat4 vp = projection * view;
@@ -710,13 +727,16 @@ void Refractor::draw(const glm::mat4& view, const glm::mat4& projection, const g
     setFloat(p, "uExposure", m.options.exposure);
     setInt(p, "uSpread", m.spread ? 1 : 0);
     setFloat(p, "uSpreadScale", m.options.spreadScale);
+    setFloat(p, "uSpreadFull", m.options.spreadFull);
     setFloat(p, "uFootprintScale", m.options.footprintScale);
     useEnvironment(p, environment, 0);
+    if (m.ior.active)
+        m.ior.setUniforms(p, m.bake.ior(), m.ior.bracket ? m.ior.bracket->impl_->bake.ior() : 0.0f);
     if (m.direct) {
         bindTexture(1, GL_TEXTURE_2D, m.lastD);
         bindTexture(2, GL_TEXTURE_2D, m.positionTex);
         bindTexture(3, GL_TEXTURE_2D, m.normalTex);
-        if (m.vertexMode()) {
+        if (vertexSh) {
             // Eye in object space, and the weights from unit 4 on (compiledFor's assignment).
             const glm::vec3 e = glm::vec3(glm::inverse(model) * glm::vec4(eye, 1.0f));
             glUniform3f(glGetUniformLocation(p, "uEyeObject"), e.x, e.y, e.z);
@@ -759,6 +779,32 @@ unsigned Refractor::refractionMap() {
     return m.rho.texture;
 }
 
+void Refractor::setIor(glm::vec3 ior) {
+    if (!(glm::all(glm::greaterThanEqual(ior, glm::vec3(1.0f))) &&
+          glm::all(glm::lessThanEqual(ior, glm::vec3(5.0f)))))
+        throw std::invalid_argument("shrefract: setIor: every index must lie in [1, 5]");
+    impl_->ior.active = true;
+    impl_->ior.ior = ior;
+}
+
+void Refractor::resetIor() { impl_->ior.active = false; }
+
+void Refractor::setIorBracket(Refractor* other) {
+    if (other) {
+        const SurfaceLayout &a = impl_->bake.data().layout, &b = other->impl_->bake.data().layout;
+        if (other == this || a.sampleCount() != b.sampleCount() ||
+            a.triangleCount != b.triangleCount || a.rate != b.rate ||
+            a.muWidth != b.muWidth || a.rhoWidth != b.rhoWidth || a.rhoHeight != b.rhoHeight)
+            throw std::invalid_argument(
+                "shrefract: setIorBracket: the bracketing bake must have this bake's layout (same "
+                "mesh and rate)");
+        if (other->impl_->bake.ior() == impl_->bake.ior())
+            throw std::invalid_argument(
+                "shrefract: setIorBracket: the bracketing bake has this bake's index of refraction");
+    }
+    impl_->ior.bracket = other;
+}
+
 glm::ivec2 Refractor::refractionMapSize() const { return {impl_->rhoW, impl_->rhoH}; }
 std::string Refractor::path() const {
     return impl_->charts ? "charts" : impl_->direct ? "direct" : "rho";
@@ -766,8 +812,12 @@ std::string Refractor::path() const {
 std::string Refractor::decompression() const { return impl_->vertexMode() ? "vertex" : "texture"; }
 
 void Refractor::setOrder(int L) {
+    // As RefractorOptions::order: -1 is every uploaded band, above maxOrder clamps to it.
+    if (L < -1)
+        throw std::invalid_argument("shrefract: setOrder(" + std::to_string(L) +
+                                    "): -1 (all) or 0 and up");
     impl_->use();
-    impl_->order = std::clamp(L, 0, impl_->maxOrder);
+    impl_->order = L < 0 ? impl_->maxOrder : std::min(L, impl_->maxOrder);
     impl_->compiledFor(impl_->order);
 }
 int Refractor::order() const { return impl_->order; }

@@ -13,6 +13,8 @@
 #include <ImfHeader.h>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "common/exr_output.h"
+#include "common/output.h"
 #include "common/png.h"
 #include "common/tonemap.h"
 #include "shrefract/baselines.h"
@@ -169,24 +171,6 @@ RenderedFrame OffscreenTarget::read() const {
     return out;
 }
 
-namespace {
-
-// Writes through `write` to PATH.tmp, then renames: a failure leaves no file at `path`.
-template <typename F>
-void writeAtomically(const std::string& path, F write) {
-    std::string tmp = path + ".tmp";
-    try {
-        write(tmp);
-        std::filesystem::rename(tmp, path);
-    } catch (const std::exception& e) {
-        std::error_code ec;
-        std::filesystem::remove(tmp, ec);
-        throw std::runtime_error(path + ": cannot write: " + e.what());
-    }
-}
-
-}  // namespace
-
 void writePng(const std::string& path, const RenderedFrame& frame, float exposure) {
     const int w = frame.width, h = frame.height;
     std::vector<unsigned char> pixels(static_cast<size_t>(w) * h * 3);
@@ -200,7 +184,7 @@ void writePng(const std::string& path, const RenderedFrame& frame, float exposur
 }
 
 void writeExr(const std::string& path, int width, int height, const std::vector<float>& rgba) {
-    writeAtomically(path, [&](const std::string& tmp) {
+    writeAtomically(path, [&](const std::string& staged) {
         Imf::Header header(width, height);
         const char* names[4] = {"R", "G", "B", "A"};
         Imf::FrameBuffer fb;
@@ -209,9 +193,11 @@ void writeExr(const std::string& path, int width, int height, const std::vector<
             fb.insert(names[c], Imf::Slice(Imf::FLOAT, (char*)(rgba.data() + c),
                                            4 * sizeof(float), 4 * sizeof(float) * width));
         }
-        Imf::OutputFile file(tmp.c_str(), header);
-        file.setFrameBuffer(fb);
-        file.writePixels(height);
+        writeExrFile(staged, [&](Imf::OStream& stream) {
+            Imf::OutputFile file(stream, header);
+            file.setFrameBuffer(fb);
+            file.writePixels(height);
+        });
     });
 }
 

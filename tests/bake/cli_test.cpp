@@ -54,7 +54,7 @@ TEST_P(BakeRejects, WithAClearErrorAndNoOutput) {
     std::string out = tmp(std::string("bad_") + c.name + ".shrefract.exr");
     fs::remove(out);
     CommandResult r = run(kBake + " " + in + " -o " + out + " --cache '' -q " + c.args);
-    EXPECT_NE(r.code, 0) << r.out;
+    EXPECT_EQ(r.code, 2) << r.out;  // bad input, CLI11's usage errors included (README)
     EXPECT_NE(r.out.find(c.expect), std::string::npos) << "message: " << r.out;
     EXPECT_FALSE(fs::exists(out));
     for (auto& e : fs::directory_iterator(SHREFRACT_TEST_TMP))
@@ -69,6 +69,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"garbage", "garbage.off", "this is not a mesh\n", "", "garbage.off"},
         BadCase{"empty", "empty.off", "", "", "empty.off"},
         BadCase{"nan", "nan.off", "OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n", "", "nan.off"},
+        BadCase{"cut", "cut.off", "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n", "",
+                "cut short: the header promises 4 vertices and 4 faces, the file ends after 2 faces"},
         BadCase{"order", "tetra.off", kTetra, "--order 99", "order"},
         BadCase{"rate", "tetra.off", kTetra, "--rate 0", "rate"},
         BadCase{"grid", "tetra.off", kTetra, "--grid 3x5", "grid"},
@@ -104,6 +106,21 @@ TEST(BakeCli, ChartLayoutsBakeTheirObjects) {
     }
 }
 
+// Say what you do: --samples becomes the smallest rate reaching it, which usually gives more
+// samples; the tool says so on stderr with the chosen value (the tetrahedron has 10 unique samples
+// at rate 2, 20 at rate 3).
+TEST(BakeCli, SamplesRoundingIsReported) {
+    write(tmp("round_tetra.off"), kTetra);
+    const std::string out = tmp("round.shrefract.exr");
+    CommandResult r = run(kBake + " " + tmp("round_tetra.off") + " -o " + out +
+                          " --samples 12 --order 1 --grid 4x8 --cache '' -q");
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_NE(r.out.find("note: --samples 12: rate 3 gives 20 unique samples"), std::string::npos) << r.out;
+    r = run(kBake + " " + tmp("round_tetra.off") + " -o " + out + " --samples 10 --order 1 --grid 4x8 --cache '' -q");
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_EQ(r.out.find("note:"), std::string::npos) << r.out;  // exactly reached: nothing to say
+}
+
 TEST(BakeCli, MissingOutputFolderIsAnErrorBeforeAnyWork) {
     write(tmp("nodir_tetra.off"), kTetra);
     CommandResult r = run(kBake + " " + tmp("nodir_tetra.off") + " -o " + tmp("no/such/dir/x.shrefract.exr") + " -q");
@@ -126,10 +143,12 @@ TEST(BakeCli, BadInputKeepsAnExistingOutputFile) {
 
 namespace {
 
-// Ctrl-C (SIGINT) mid-bake: a clean stop, exit 130, no output file and no temporary left.
+// Ctrl-C (SIGINT) mid-bake: a clean stop, exit 130, no output file and no temporary left; the
+// checkpoints finished so far (none after a second) stay for --resume.
 TEST(BakeCli, InterruptStopsCleanlyAndWritesNothing) {
     const std::string out = tmp("interrupted.shrefract.exr");
     fs::remove(out);
+    fs::remove_all(out + ".work");
     // knot1 at rate 3 takes tens of seconds: long enough to interrupt after one.
     const std::string cmd = "sh -c '" + kBake + " " + std::string(SHREFRACT_DATA_DIR) +
                             "/meshes/knot1.off -o " + out +
@@ -137,7 +156,9 @@ TEST(BakeCli, InterruptStopsCleanlyAndWritesNothing) {
     CommandResult r = run(cmd);
     EXPECT_EQ(r.code, 130) << r.out;
     EXPECT_NE(r.out.find("cancelled"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("--resume"), std::string::npos) << r.out;
     EXPECT_FALSE(fs::exists(out));
+    fs::remove_all(out + ".work");
     for (auto& e : fs::directory_iterator(SHREFRACT_TEST_TMP))
         EXPECT_NE(e.path().string().rfind(out + ".tmp", 0), 0u) << "left behind: " << e.path();
 }

@@ -59,14 +59,15 @@ std::vector<std::string> leftovers(const fs::path& dir) {
     std::vector<std::string> names;
     for (const auto& e : fs::directory_iterator(dir)) {
         const std::string name = e.path().filename().string();
-        if (name.find(".tmp.") != std::string::npos) names.push_back(name);
+        if (name.find(".shrefract-tmp.") != std::string::npos) names.push_back(name);
     }
     return names;
 }
 
-// Order 4 (15 stored coefficients), 37 samples in a 7 x 6 mu layout, 3 triangles at rate 2 in
-// 4 x 4 blocks (2 per row) of an 8 x 8 rho layout holding all three texel kinds, and neighbour
-// lists of 1..4 entries. Weights in [-1, 1] for x, y, z and lengths in [0, 3].
+// Order 4 (15 stored coefficients), 37 samples in a 7 x 6 mu layout on 3 parts, 3 triangles at
+// rate 2 in (r + 1) x (r + 4) = 3 x 6 blocks (2 per row) of a 6 x 12 rho layout holding all three
+// texel kinds where the format puts them, and neighbour lists of 1..4 entries. Weights in [-1, 1]
+// for x, y, z and lengths in [0, 3].
 BakeData syntheticBake(Precision precision, uint32_t seed = 7) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> unit(-1.0f, 1.0f), length(0.0f, 3.0f);
@@ -82,16 +83,26 @@ BakeData syntheticBake(Precision precision, uint32_t seed = 7) {
         L.normal.push_back(glm::normalize(glm::vec3(unit(rng), unit(rng), 1.5f)));
         L.part.push_back(uint32_t(i % 3));
     }
-    L.rhoWidth = 8, L.rhoHeight = 8;
-    L.blockWidth = 4, L.blockHeight = 4, L.blocksPerRow = 2;
+    L.rhoWidth = 6, L.rhoHeight = 12;
+    L.blockWidth = 3, L.blockHeight = 6, L.blocksPerRow = 2;
     L.triangleCount = 3;
-    L.rho.resize(64);
-    for (int t = 0; t < 64; ++t) {
-        RhoTexel& r = L.rho[t];
-        r.kind = uint32_t(t % 3);
-        if (r.kind == RhoTexel::Sample) r.a = uint32_t((t * 5) % N);
-        if (r.kind == RhoTexel::Correction)
-            r.a = uint32_t(t % N), r.b = uint32_t((t + 1) % N), r.c = uint32_t((t + 11) % N);
+    L.rho.resize(size_t(L.rhoWidth) * L.rhoHeight);
+    // Triangle t's six grid samples are mu samples 6t + 1 .. 6t + 6 (sample 0 and those past 18
+    // are on no triangle); its two corrections v11 = v01 + v10 - v00 refer to its own samples.
+    for (int t = 0; t < L.triangleCount; ++t) {
+        uint32_t next = uint32_t(6 * t + 1);
+        for (int j = 0; j <= L.rate; ++j)
+            for (int i = 0; i + j <= L.rate; ++i) {
+                const glm::ivec2 x = L.rhoTexel(t, i, j);
+                L.rho[size_t(x.y) * L.rhoWidth + x.x] = {RhoTexel::Sample, next++, 0, 0};
+            }
+        for (int i = 1; i <= L.rate; ++i) {
+            const int j = L.rate + 1 - i;
+            const glm::ivec2 x = L.rhoTexel(t, i, j);
+            L.rho[size_t(x.y) * L.rhoWidth + x.x] = {RhoTexel::Correction, L.sampleAt(t, i - 1, j),
+                                                     L.sampleAt(t, i, j - 1),
+                                                     L.sampleAt(t, i - 1, j - 1)};
+        }
     }
     for (int i = 0; i < N; ++i) {
         const uint32_t count = 1 + uint32_t(i % 4);
@@ -109,7 +120,9 @@ BakeData syntheticBake(Precision precision, uint32_t seed = 7) {
     d.manifest = {
         {"grid", {{"theta", 32}, {"phi", 64}}},
         {"filter", {{"kind", "semi-gaussian"}, {"width", 0.25}}},
-        {"media", json::array({{{"name", "glass"}, {"ior", 1.5}}})},
+        {"media", json::array({{{"name", "glass"}, {"ior", 1.5}},
+                               {{"name", "water"}, {"ior", 1.33}},
+                               {{"name", "air bubble"}, {"ior", 1.0}}})},
         {"meshChecksum", "fnv1a64:0123456789abcdef"},
         {"shConvention", "real, orthonormal, no Condon-Shortley phase"},
         {"stats", {{"tirPaths", 12}, {"cappedPaths", 0}}},
@@ -428,8 +441,8 @@ TEST(Format, ManifestKeepsCallerFieldsAndAddsLayout) {
     EXPECT_EQ(m.at("precision"), "u8");
     EXPECT_EQ(m.at("sampleCount"), 37);
     EXPECT_EQ(m.at("mu"), json::array({7, 6}));
-    EXPECT_EQ(m.at("rho"), json::array({8, 8}));
-    EXPECT_EQ(m.at("block"), json::array({4, 4, 2}));
+    EXPECT_EQ(m.at("rho"), json::array({6, 12}));
+    EXPECT_EQ(m.at("block"), json::array({3, 6, 2}));
     EXPECT_EQ(m.at("triangleCount"), 3);
     EXPECT_EQ(m.at("rate"), 2);
     EXPECT_EQ(m.at("neighbourListLength"), d.layout.neighbourIndex.size());
@@ -649,6 +662,130 @@ TEST(Format, InconsistentSizesAreReported) {
     expectInputError(dir / "list.shrefract.exr", "neighbours of sample 36");
 }
 
+// The manifest's values go through the checks shrefract-bake applies to its options and a scene
+// to its media (common/limits.h, mediumProblem, gridProblem), on files whose checksums are
+// right: what the bake would refuse to make is refused on reading, naming the key.
+TEST(Format, ManifestValuesAreValidatedLikeTheBakeOptions) {
+    const fs::path dir = scratch();
+    const fs::path ok = dir / "ok.shrefract.exr";
+    writeBake(ok.string(), syntheticBake(Precision::F32));
+    const std::pair<std::function<void(json&)>, std::string> cases[] = {
+        {[](json& m) { m["media"][0]["ior"] = 0.0; }, "media[0]: 'ior' 0 is not in [1, 5]"},
+        {[](json& m) { m["media"][1]["ior"] = 7.5; }, "media[1]: 'ior' 7.5 is not in [1, 5]"},
+        {[](json& m) { m["media"][2]["absorption"] = {0.1, -1.0, 0.0}; },
+         "media[2]: 'absorption' has -1"},
+        {[](json& m) { m["media"][0]["ior"] = "1.5"; }, "media[0]: 'ior' is not a number"},
+        {[](json& m) { m["media"] = json::array({m["media"][0]}); },
+         "sample 1 lies on part 1 but the manifest has 1 media"},
+        {[](json& m) { m["grid"] = {32, 63}; }, "NPHI must be even"},
+        {[](json& m) { m["grid"] = {1, 64}; }, "counts must lie in [2, 1024]"},
+        {[](json& m) { m["maxBounces"] = 0; }, "\"maxBounces\" 0 is not in [1, 10000]"},
+        {[](json& m) { m["filterWidth"] = -2.0; }, "\"filterWidth\" -2.0 is not in [0, 1000]"},
+        {[](json& m) { m["branch"] = "reflect"; }, "\"branch\" \"reflect\""},
+        {[](json& m) { m["order"] = 25, m["coefficients"] = 351; }, "SH order 25 is not in [0, 20]"},
+        {[](json& m) { m["rate"] = 65; }, "rate 65 is not in [1, 64]"},
+        {[](json& m) { m["sampleCount"] = 4294967296ll; }, "manifest has no integer \"sampleCount\""},
+        {[](json& m) { m["mu"] = {40000, 1}; }, "above 32768"},
+        // The list would be read past its part's pixels.
+        {[](json& m) { m["neighbourListLength"] = 101; },
+         "neighbour list of 101 entries does not fit its 10 x 10 part"},
+    };
+    int n = 0;
+    for (const auto& [edit, what] : cases) {
+        const fs::path bad = dir / ("bad" + std::to_string(n++) + ".shrefract.exr");
+        rewrite(ok, bad, edit);
+        SCOPED_TRACE(what);
+        expectInputError(bad, what);
+    }
+}
+
+// The layout read back is one the runtime can walk without a bounds check: every triangle's grid
+// positions hold samples and its corrections lie past its hypotenuse, blocks hold two triangles,
+// normals are unit, neighbour lists start with the sample and their weights sum to 1, weights are
+// finite. Each broken in a file with correct checksums (and unverified) is refused.
+TEST(Format, LayoutIsInternallyConsistent) {
+    const fs::path dir = scratch();
+    const fs::path ok = dir / "ok.shrefract.exr";
+    writeBake(ok.string(), syntheticBake(Precision::F16));
+    auto setU = [](std::vector<char>& bytes, size_t texel, uint32_t v) {
+        std::memcpy(&bytes[4 * texel], &v, 4);
+    };
+    auto setF = [](std::vector<char>& bytes, size_t texel, float v) {
+        std::memcpy(&bytes[4 * texel], &v, 4);
+    };
+    struct Case {
+        std::string part, channel;
+        std::function<void(std::vector<char>&)> edit;
+        std::string what;
+    };
+    const Case cases[] = {
+        // Texel (0, 0) is triangle 0's sample (0, 0); (1, 2) its correction (1, 2).
+        {"rho", "kind", [&](auto& b) { setU(b, 0, RhoTexel::Empty); },
+         "triangle 0's sample texel (0, 0) at rho (0, 0) has kind 0"},
+        {"rho", "kind", [&](auto& b) { setU(b, 2 * 6 + 1, RhoTexel::Sample); },
+         "triangle 0's correction texel (1, 2) at rho (1, 2) has kind 1"},
+        {"samples", "N.x", [&](auto& b) { setF(b, 5, 3.0f); }, "sample 5 has a normal of length"},
+        {"samples", "P.y", [&](auto& b) { setF(b, 6, INFINITY); }, "sample 6 has a non-finite position"},
+        {"neighbour_list", "index", [&](auto& b) { setU(b, 0, 1); },
+         "the neighbour list of sample 0 does not start with the sample itself"},
+        {"neighbour_list", "weight", [&](auto& b) { setF(b, 0, 0.5f); },
+         "the neighbour weights of sample 0 sum to 0.5"},
+        {"neighbour_list", "weight", [&](auto& b) { setF(b, 3, NAN); },
+         "neighbour list entry 3 has a non-finite weight"},
+        {"weights", "w002.z", [&](auto& b) {
+             const half inf = half::posInf();
+             std::memcpy(&b[2 * 4], &inf, 2);
+         }, "weight 2 of sample 4 channel z is not finite"},
+    };
+    int n = 0;
+    for (const Case& c : cases) {
+        const fs::path bad = dir / ("layout" + std::to_string(n++) + ".shrefract.exr");
+        rewrite(
+            ok, bad, [](json&) {},
+            [&](const std::string& part, const std::string& channel, std::vector<char>& bytes) {
+                if (part == c.part && channel == c.channel) c.edit(bytes);
+            });
+        SCOPED_TRACE(c.what);
+        expectInputError(bad, "inconsistent bake: " + c.what);
+        ReadOptions fast;
+        fast.verify = false;
+        EXPECT_THROW(readBake(bad.string(), fast), InputError);
+    }
+    // Blocks too small for two triangles at the rate: 2 x 6 at rate 2 (needs w, h >= 3, w + h >= 9).
+    rewrite(ok, dir / "block.shrefract.exr", [](json& m) { m["block"] = {2, 6, 3}; });
+    expectInputError(dir / "block.shrefract.exr", "rho blocks of 2 x 6 texels cannot hold two");
+}
+
+// Sizes beyond what the file's bytes can decode to are refused before anything is allocated: a
+// file of a few kilobytes whose headers and manifest agree on a 20000 x 20000 mu layout (and hold
+// no pixels) would otherwise ask for 20000^2 x (15 x 16 + 36) bytes = 110 GB.
+TEST(Format, SizesBeyondTheFileAreRefusedBeforeAllocating) {
+    const fs::path dir = scratch();
+    const fs::path ok = dir / "ok.shrefract.exr", huge = dir / "huge.shrefract.exr";
+    writeBake(ok.string(), syntheticBake(Precision::F32));
+    {
+        Imf::MultiPartInputFile in(ok.c_str());
+        std::vector<Imf::Header> headers;
+        for (int p = 0; p < in.parts(); ++p) headers.push_back(in.header(p));
+        json m = json::parse(
+            headers[0].typedAttribute<Imf::StringAttribute>("shrefract.manifest").value());
+        m["mu"] = {20000, 20000};
+        const std::string text = m.dump();
+        const Imath::Box2i big({0, 0}, {19999, 19999});
+        for (Imf::Header& h : headers) {
+            h.displayWindow() = big;
+            if (h.name() == "weights" || h.name() == "samples" || h.name() == "neighbours")
+                h.dataWindow() = big;
+            h.typedAttribute<Imf::StringAttribute>("shrefract.manifest").value() = text;
+            h.typedAttribute<Imf::StringAttribute>("shrefract.manifestChecksum").value() =
+                checksumHex(text);
+        }
+        Imf::MultiPartOutputFile out(huge.c_str(), headers.data(), int(headers.size()));
+    }  // no pixels written: the chunk tables stay empty
+    ASSERT_LT(fs::file_size(huge), 200000u);
+    expectInputError(huge, "truncated or corrupt: its parts would hold");
+}
+
 TEST(Format, WriteIntoMissingDirectoryLeavesNothing) {
     const fs::path dir = scratch();
     const fs::path path = dir / "missing" / "out.shrefract.exr";
@@ -807,8 +944,9 @@ TEST(Format, EveryPartIsCheckedAgainstItsChecksum) {
             chartPart ? okCharts : ok, bad, [](json&) {},
             [&, part = part, channel = channel](const std::string& p, const std::string& c,
                                                 std::vector<char>& bytes) {
-                // Flip the lowest bit of the first value: consistent, only the checksum sees it.
-                if (p == part && c == channel) bytes[0] ^= 1;
+                // Flip the lowest bit of the first value (for rho, of the empty texel (0, 3)):
+                // consistent, only the checksum sees it.
+                if (p == part && c == channel) bytes[p == "rho" ? 4 * (3 * 6 + 0) : 0] ^= 1;
             },
             /*resign=*/false);
         expectInputError(bad, std::string("part \"") + part + "\" is corrupt");

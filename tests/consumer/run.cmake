@@ -1,7 +1,7 @@
 # PackageConsumer: install the build tree's runtime component into a fresh prefix, configure and
 # build tests/consumer against it, run it on a bake.
 #   cmake -DBUILD_DIR=... -DSOURCE_DIR=... -DWORK_DIR=... -DBAKE=... -DGENERATOR=...
-#         [-DCXX_COMPILER=...] [-DLAUNCHER=...] -P run.cmake
+#         [-DCXX_COMPILER=...] [-DLAUNCHER=...] [-DCXX_FLAGS=...] -P run.cmake
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc)
   if(NOT rc EQUAL 0)
@@ -28,6 +28,9 @@ if(CXX_COMPILER)
 endif()
 if(LAUNCHER)
   list(APPEND args -DCMAKE_CXX_COMPILER_LAUNCHER=${LAUNCHER})
+endif()
+if(CXX_FLAGS)  # a sanitizer build's instrumented library needs the same flags to link
+  list(APPEND args "-DCMAKE_CXX_FLAGS=${CXX_FLAGS}")
 endif()
 run(${CMAKE_COMMAND} ${args})
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/build)

@@ -17,6 +17,7 @@ const auto& write = shrefract::test::writeText;
 
 const std::string kBake = SHREFRACT_BAKE_EXE;
 const std::string kEval = SHREFRACT_EVAL_EXE;
+const std::string kRender = SHREFRACT_RENDER_EXE;
 constexpr const char* kTetra = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
 
 // A whole small bake, then the evaluation tools on it: the error table, and query answers
@@ -47,9 +48,57 @@ TEST(EvalCli, BakesAndEvaluatesATetrahedron) {
 
     write(tmp("bad.csv"), "1,2,3\n");
     CommandResult qb = run(kEval + " query " + out + " --in " + tmp("bad.csv") + " --out " + tmp("b.csv"));
-    EXPECT_NE(qb.code, 0);
+    EXPECT_EQ(qb.code, 2);
     EXPECT_NE(qb.out.find("bad.csv"), std::string::npos) << qb.out;
     EXPECT_FALSE(fs::exists(tmp("b.csv")));
+
+    // A point 5 units off the surface, and a direction into the surface, are refused with the
+    // line named (the bake knows nothing there); a point within --max-distance is answered.
+    const std::pair<std::string, std::string> refused[] = {
+        {"px,py,pz,wx,wy,wz\n0.2,0.2,0,0,0,-1\n0.2,0.2,-5,0,0,-1\n",
+         "line 3: point (0.2, 0.2, -5) is 5 from the surface"},
+        {"0.2,0.2,0,0,0,-1\n\n0.2,0.2,0,0.1,0,1\n", "line 3: view direction (0.1, 0, 1) points into the surface"},
+    };
+    for (const auto& [csv, what] : refused) {
+        write(tmp("off.csv"), csv);
+        CommandResult r = run(kEval + " query " + out + " --in " + tmp("off.csv") + " --out " + tmp("off_a.csv"));
+        EXPECT_EQ(r.code, 2) << r.out;
+        EXPECT_NE(r.out.find(tmp("off.csv") + ": " + what), std::string::npos) << r.out;
+        EXPECT_FALSE(fs::exists(tmp("off_a.csv")));
+    }
+    write(tmp("near.csv"), "0.2,0.2,-0.01,0,0,-1\n");
+    CommandResult near = run(kEval + " query " + out + " --in " + tmp("near.csv") + " --out " + tmp("near_a.csv"));
+    EXPECT_EQ(near.code, 2) << near.out;  // 0.01 off: beyond 0.001 of the diagonal (1.7e-3)
+    near = run(kEval + " query " + out + " --in " + tmp("near.csv") + " --out " + tmp("near_a.csv") +
+               " --max-distance 0.02");
+    EXPECT_EQ(near.code, 0) << near.out;
+
+    // An --order the bake does not store is refused, not clamped.
+    CommandResult o = run(kEval + " directions " + out + " --pairs 10 --order 5");
+    EXPECT_EQ(o.code, 2) << o.out;
+    EXPECT_NE(o.out.find("--order 5: " + out + " stores orders 0..4"), std::string::npos) << o.out;
+}
+
+// One exit-code table for every tool (README "Exit codes"): 0 for --help and --version (which names
+// the project and format versions), 2 for a usage error CLI11 reports (its own codes are 105-109)
+// and for bad input, with one "TOOL: error:" line.
+TEST(EvalCli, EveryToolSharesTheExitCodes) {
+    const std::pair<std::string, std::string> tools[] = {{kBake, "shrefract-bake"},
+                                                         {kEval, "shrefract-eval"},
+                                                         {kRender, "shrefract-render"}};
+    for (const auto& [exe, name] : tools) {
+        CommandResult v = run(exe + " --version");
+        EXPECT_EQ(v.code, 0) << v.out;
+        EXPECT_EQ(v.out.find(name + " "), 0u) << v.out;
+        EXPECT_NE(v.out.find("(bake format 2)"), std::string::npos) << v.out;
+        EXPECT_EQ(run(exe + " --help").code, 0) << name;
+        CommandResult u = run(exe + " --no-such-option");
+        EXPECT_EQ(u.code, 2) << name << ": " << u.out;
+    }
+    CommandResult r = run(kRender + " " + tmp("missing.shrefract.exr") + " --env x.exr --size 8x8");
+    EXPECT_EQ(r.code, 2) << r.out;
+    EXPECT_NE(r.out.find("shrefract-render: error: " + tmp("missing.shrefract.exr") + ": file not found"),
+              std::string::npos) << r.out;
 }
 
 }  // namespace

@@ -79,6 +79,18 @@ TEST(ImageEval, SsimDropsWithNoiseAndIsSymmetric) {
 }
 
 // The reference camera is glm's: the ray through a pixel centre projects back onto it.
+// Dispersion's composition: channel c from buffer c, coverage and directions from green.
+TEST(Reference, ComposeChannelsTakesEachChannelFromItsBuffer) {
+    const EvalBuffer r = randomBuffer(7, 5, 1), g = randomBuffer(7, 5, 2), b = randomBuffer(7, 5, 3);
+    const EvalBuffer c = composeChannels(r, g, b);
+    ASSERT_EQ(c.pixelCount(), g.pixelCount());
+    for (size_t i = 0; i < c.pixelCount(); ++i) {
+        EXPECT_EQ(c.color[i], glm::vec4(r.color[i].r, g.color[i].g, b.color[i].b, g.color[i].a));
+        EXPECT_EQ(c.direction[i], g.direction[i]);
+    }
+    EXPECT_THROW(composeChannels(r, g, randomBuffer(5, 7, 3)), std::invalid_argument);
+}
+
 TEST(Reference, PrimaryRayHitsThePixelCentreUnderTheGlProjection) {
     ReferenceView v;
     v.eye = {1.0f, 0.7f, 2.5f}, v.target = {0.1f, -0.2f, 0.0f}, v.fovDegrees = 40.0f;

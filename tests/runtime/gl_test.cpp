@@ -54,6 +54,14 @@ TEST_P(GlTest, DecompressionEqualsCpuAtEveryMuSample) {
             r->setOrder(1);
             EXPECT_EQ(r->order(), 1);
             EXPECT_LT(maxDecompressionError(*r, data, glm::vec3(1, 2, 2), 1), 1e-4f);
+            // -1 means every band, as RefractorOptions::order = -1 does; above the stored order
+            // clamps to it; below -1 is refused.
+            r->setOrder(-1);
+            EXPECT_EQ(r->order(), order);
+            EXPECT_EQ(refractor(bake, preset)->order(), order);
+            r->setOrder(order + 3);
+            EXPECT_EQ(r->order(), order);
+            EXPECT_THROW(r->setOrder(-2), std::invalid_argument);
         }
     }
 }

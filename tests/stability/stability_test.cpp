@@ -112,6 +112,15 @@ BakeOptions small(int order = 8) {
 
 double median(const CaseResult& r) { return r.eval["angleDeg"]["median"].get<double>(); }
 
+// The bakes and evaluations are deterministic (fixed seeds, batches independent of threading), so
+// each case's median error is a measured number (docs/stability.md); it may grow by at most 30%
+// before the test fails. A looser bound (the 45 degrees these tests had) lets a wrong Fresnel or
+// filter through.
+void expectMedianNear(const CaseResult& r, double measured) {
+    EXPECT_LT(median(r), 1.3 * measured) << r.row["case"].get<std::string>() << ": measured "
+                                         << measured << " deg when this limit was set";
+}
+
 Scene load(const std::string& rel, double ior = 1.5) {
     Medium m;
     m.ior = ior;
@@ -126,7 +135,8 @@ TEST(Stability, DiamondIorTotalInternalReflection) {
     // On a perfect sphere TIR cannot happen (the internal angle equals the refracted one);
     // on the facets it does, and more often at IOR 2.42: measured 7.2% vs 6.6% of paths.
     EXPECT_GT(r.row["tir"].get<double>(), glass.row["tir"].get<double>());
-    EXPECT_LT(median(r), 45.0);
+    expectMedianNear(glass, 2.11);
+    expectMedianNear(r, 2.32);
 }
 
 TEST(Stability, GrazingEntry) {
@@ -138,7 +148,7 @@ TEST(Stability, GrazingEntry) {
     // 54.7 deg against 2.1 over the whole hemisphere; the test pins that the failure is
     // confined to grazing directions.
     EXPECT_GT(median(r), 5 * median(all));
-    EXPECT_LT(median(all), 5.0);
+    expectMedianNear(all, 2.11);
 }
 
 TEST(Stability, SphereWhisperingGallery) {
@@ -147,12 +157,13 @@ TEST(Stability, SphereWhisperingGallery) {
     CaseResult r = runCase("whispering", "sphere, cap 8: grazing paths circle inside until capped",
                            load("scenes/icosphere.off"), o, 0.0f, 0.05f);
     EXPECT_GT(r.row["softCapped"].get<double>() + r.row["capped"].get<double>(), 0.0);
+    expectMedianNear(r, 22.05);
 }
 
 TEST(Stability, BeadInShell) {
     CaseResult r = runCase("bead_in_shell", "glass shell (r 1, 0.9) around a bead (r 0.4): depth complexity 4",
                            load("scenes/bead_in_shell.json"), small());
-    EXPECT_LT(median(r), 45.0);
+    expectMedianNear(r, 1.77);
 }
 
 TEST(Stability, ThinShell) {
@@ -162,7 +173,7 @@ TEST(Stability, ThinShell) {
     for (auto& n : inner.normals) n = -n;
     test::append(shell, inner);
     CaseResult r = runCase("thin_shell", "sphere shell 3% thick", test::sceneOf(shell), small());
-    EXPECT_LT(median(r), 45.0);
+    expectMedianNear(r, 0.28);
 }
 
 TEST(Stability, FlatFacesAndFilterAgainstRinging) {
@@ -173,8 +184,8 @@ TEST(Stability, FlatFacesAndFilterAgainstRinging) {
     CaseResult raw = runCase("box_nofilter", "flat-faced box, no SH filter: discontinuities, Gibbs", box, o);
     o.filterWidth = 4;
     CaseResult filtered = runCase("box_filter4", "flat-faced box, semi-Gaussian filter width 4", box, o);
-    EXPECT_LT(median(raw), 60.0);
-    EXPECT_LT(median(filtered), 60.0);
+    expectMedianNear(raw, 1.84);
+    expectMedianNear(filtered, 1.24);
 }
 
 TEST(Stability, CoarseMeshesWithoutShadingNormals) {
@@ -183,6 +194,8 @@ TEST(Stability, CoarseMeshesWithoutShadingNormals) {
     CaseResult cube = runCase("coarse_cube", "8-vertex cube: corner normals averaged over 3 faces",
                               load("scenes/cube.off"), small());
     EXPECT_GT(cube.row["geometricNormal"].get<double>(), 0.0);  // the fallback is exercised
+    expectMedianNear(sphere, 2.73);
+    expectMedianNear(cube, 9.44);
 }
 
 TEST(Stability, DegenerateAndSliverTriangles) {
@@ -197,19 +210,20 @@ TEST(Stability, DegenerateAndSliverTriangles) {
                                  "3 0 2 4\n3 2 1 4\n3 1 0 4\n3 0 1 3\n3 0 3 2\n3 1 2 3\n3 5 5 5\n";
     Scene s = loadScene(degenerate);
     EXPECT_GE(s.parts[0].report.degenerateTriangles, 1u);
-    runCase("sliver", "tetrahedron with two sliver triangles (1e-4 high) and a skipped degenerate one", s, small());
+    expectMedianNear(runCase("sliver", "tetrahedron with two sliver triangles (1e-4 high) and a skipped degenerate one", s, small()), 2.54);
 }
 
 TEST(Stability, OpenAndNonManifoldMeshes) {
     CaseResult open = runCase("open_cube", "cube missing a face: paths leak out", load("scenes/open_cube.off"), small());
     EXPECT_GT(open.row["leaked"].get<double>(), 0.0);  // counted, not hidden
+    expectMedianNear(open, 5.63);
     fs::create_directories(kTmp);
     std::string fin = kTmp + "/fin.off";
     std::ofstream(fin) << "OFF\n5 5 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n0.5 -1 0.5\n"
                           "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n3 0 1 4\n";
     Scene s = loadScene(fin);
     EXPECT_EQ(s.parts[0].report.nonManifoldEdges, 1u);
-    runCase("nonmanifold", "tetrahedron with a fin on one edge (non-manifold)", s, small());
+    expectMedianNear(runCase("nonmanifold", "tetrahedron with a fin on one edge (non-manifold)", s, small()), 1.64);
 }
 
 TEST(Stability, VeryLargeAndVerySmallScales) {
@@ -239,6 +253,7 @@ TEST(Stability, EightBitWeights) {
     CaseResult u8 = runCase("cow_u8", "cow, 8-bit weights (per-coefficient scale/offset)", s, o);
     // The paper's Figure 5 claim, measured: 8-bit costs little next to SH truncation itself.
     EXPECT_LT(median(u8) - median(f32), 1.0);
+    expectMedianNear(f32, 14.14);
 }
 
 TEST(Stability, HighOrderInFloat32) {
@@ -246,6 +261,8 @@ TEST(Stability, HighOrderInFloat32) {
                            load("scenes/icosphere.off"), small(16));
     CaseResult r8 = runCase("order8", "sphere at order 8", load("scenes/icosphere.off"), small(8));
     EXPECT_LT(median(r), median(r8) + 0.5);  // more bands must not make it worse
+    expectMedianNear(r, 1.68);
+    expectMedianNear(r8, 2.11);
 }
 
 }  // namespace

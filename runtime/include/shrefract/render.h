@@ -65,8 +65,9 @@ RenderedFrame renderFrame(Baseline& baseline, const Environment& environment, co
 glm::mat4 viewMatrix(const Camera& camera);
 glm::mat4 projectionMatrix(const Camera& camera, int width, int height);
 
-// Writes 8-bit sRGB PNG of toneMap(color), or float RGBA EXR; throws std::runtime_error naming
-// the file. Both write to a temporary name and rename, so a failure leaves no file.
+// Writes 8-bit sRGB PNG of toneMap(color), or float RGBA EXR. Both write a temporary file beside
+// `path` and rename it when complete: a failure (std::runtime_error naming the file and the OS's
+// reason) leaves `path` as it was, and a symbolic link, FIFO or device there is never replaced.
 void writePng(const std::string& path, const RenderedFrame& frame, float exposure = 1.0f);
 void writeExr(const std::string& path, int width, int height, const std::vector<float>& rgba);
 

@@ -14,6 +14,13 @@ namespace shrefract {
 
 struct BakeData;  // common/bakefile.h
 
+// A vertex of the mesh the refraction map is laid out for (Bake::refractionMapMesh).
+struct MapVertex {
+    glm::vec3 position;  // object space
+    glm::vec3 normal;    // unit shading normal, object space
+    glm::vec2 uv;        // refraction-map texture coordinate (the rho layout), texel centres
+};
+
 // A loaded bake, cheap to copy (shared, immutable).
 class Bake {
 public:
@@ -28,6 +35,10 @@ public:
     // What loading noticed that the app should show its user, e.g. an older format version
     // whose data cannot be verified.
     const std::vector<std::string>& warnings() const;
+    // The mesh refractionMap() is laid out for, three vertices per triangle (no index buffer):
+    // an app that shades the glass in its own material draws these and samples the map at uv
+    // (docs/integrate.md).
+    std::vector<MapVertex> refractionMapMesh() const;
     const BakeData& data() const;
 
 private:
@@ -48,9 +59,11 @@ Bake makeBake(BakeData data);
 // Lat-long convention: +y up; u = 0.5 + atan2(d.x, -d.z) / 2pi, v = acos(d.y) / pi (row 0 top).
 class Environment {
 public:
-    // Loads a lat-long EXR into a cube map of `faceSize` (0: height / 2); throws InputError.
+    // Loads a lat-long EXR into a cube map of `faceSize` (0: height / 2); throws InputError naming
+    // the file: missing, not an image, a bake, not 2:1 (+-1 pixel), NaN or inf pixels.
     static Environment loadLatLong(const std::string& path, int faceSize = 0);
-    // Builds the cube map from lat-long RGB floats, row-major, row 0 = top (+y).
+    // Builds the cube map from lat-long RGB floats, row-major, row 0 = top (+y): 2:1 (+-1 pixel),
+    // every value finite, else std::invalid_argument.
     static Environment fromLatLong(int width, int height, const std::vector<float>& rgb,
                                    int faceSize = 0);
     Environment(Environment&&) noexcept;
@@ -117,7 +130,8 @@ struct RefractorOptions {
     // draw; needs a one-pass preset and no smoothing); "texture": decompression passes into D_mu
     // first; "auto": the measured default (docs/runtime.md).
     std::string decompression = "auto";
-    int order = -1;                 // SH order used, -1: all stored
+    int order = -1;                 // SH order used, -1: all uploaded; above maxOrder clamps
+                                    // to it (order() tells); below -1: std::invalid_argument
     int maxOrder = -1;              // bands uploaded to the GPU, 0..maxOrder (-1: all stored);
                                     // setOrder() cannot go above it
     // Float32 bakes upload as RGBA16F (half the memory). f16 bakes are always RGBA16F, u8 bakes
@@ -130,6 +144,9 @@ struct RefractorOptions {
     // "sharp": the paper's single lookup along the exit direction (docs/runtime.md).
     std::string shading = "spread";
     float spreadScale = 1.0f;       // lobe width factor (spread shading)
+    // The reconstruction length counted as fully coherent (spread shading): the SH of even a
+    // smooth mapping come out a little short, and their length is divided by this first.
+    float spreadFull = 1.0f;
     float footprintScale = 0.5f;    // screen-space footprint factor (spread shading)
     // Chart layouts (isolated, uv; paper §5.2): gutter rings filled around the charts by
     // dilation (-1: the bake's gutter; 0: none), and whether gutter texels next to a smooth seam
@@ -161,7 +178,8 @@ public:
     glm::ivec2 refractionMapSize() const;
     std::string path() const;           // "rho", "direct", or "charts" for chart bakes
     std::string decompression() const;  // "texture" or "vertex"
-    // Progressive decompression (paper §6): use bands 0..L, clamped to the uploaded maxOrder.
+    // Progressive decompression (paper §6): use bands 0..L, as RefractorOptions::order does:
+    // -1 is all uploaded bands, above maxOrder clamps to it, below -1 is std::invalid_argument.
     void setOrder(int L);
     int order() const;
     void setSmoothing(bool on);
@@ -172,6 +190,17 @@ public:
     void setSeamAware(bool on);
     bool seamAware() const;
     void setCorrection(bool on);  // off only to show the seams it removes
+    // Shades as if the object had index `ior` per RGB channel (different: dispersion), each in
+    // [1, 5] (docs/runtime.md "Variable IOR and dispersion"). With one bake each channel's exit
+    // interpolates between the straight path (index 1) and the baked one, the paper's §5.4
+    // (which has no physical basis); with setIorBracket, between two bakes.
+    void setIor(glm::vec3 ior);
+    void resetIor();  // back to the bake's own index
+    // A bake of the same mesh and layout at another index, interpolated with this one per
+    // channel for setIor(); update() updates it too (its stage times add to timings()). It must
+    // outlive this refractor or be unset (nullptr). Throws std::invalid_argument if the layouts
+    // differ or the index is the same.
+    void setIorBracket(Refractor* other);
     // GL timer queries per stage (RefractorOptions::timings); off zeroes timings().
     void setTimings(bool on);
     const Timings& timings() const;

@@ -1,0 +1,27 @@
+// Uniform subdivision of a mesh file with OpenMesh's subdividers: how the Lucy-class test mesh is
+// made from bunny00 (scripts/bench-lucy), without committing a large mesh.
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+namespace shrefract {
+
+enum class Subdivision {
+    Loop,   // Loop 1987: 4 triangles per triangle, a vertex per edge
+    Sqrt3,  // Kobbelt 2000: 3 triangles per triangle, a vertex per face
+};
+Subdivision parseSubdivision(const std::string& text);  // "loop" | "sqrt3"; throws InputError
+
+struct SubdivisionResult {
+    size_t vertices = 0, triangles = 0;
+};
+
+// Reads `input` (checked as every mesh the bake reads), subdivides it `steps` times and writes
+// the result to `output` (format by extension; positions and triangles only, so readers derive
+// the normals of the smooth surface). Written to a temporary name and renamed. Throws
+// InputError naming the file.
+SubdivisionResult subdivideMeshFile(const std::string& input, const std::string& output,
+                                    Subdivision scheme, int steps);
+
+}  // namespace shrefract

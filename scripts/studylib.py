@@ -1,0 +1,177 @@
+"""What the study scripts share (scripts/study-mug, study-ior, study-orders): the built tools,
+bakes made once into a work folder and reused by every study, renders and their comparison.
+Python standard library only.
+"""
+import glob
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+import time
+
+ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+
+
+def add_arguments(ap, size=384, spp=1):
+    ap.add_argument("--build", default=os.path.join(ROOT, "build"))
+    ap.add_argument("--work", default=None, help="bakes, renders, reports (default BUILD/studies)")
+    ap.add_argument("--size", type=int, default=size)
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--backend", default="egl")
+    ap.add_argument("--frames", type=int, default=3)
+    ap.add_argument("--spp", type=int, default=spp,
+                    help="samples per pixel of the reference's colour (its directions: 1)")
+
+
+class Tools:
+    def __init__(self, args, name):
+        self.name = name
+        self.args = args
+        self.exe = {t: os.path.join(args.build, folder, "shrefract-" + t)
+                    for t, folder in (("bake", "bake"), ("eval", "eval"), ("render", "eval"))}
+        for t, path in self.exe.items():
+            if not os.path.exists(path):
+                sys.exit("%s: shrefract-%s not built (%s): ninja -C %s shrefract-%s"
+                         % (name, t, path, args.build, t))
+        self.work = args.work or os.path.join(args.build, "studies")
+        for sub in ("bakes", "renders", "reports", "scenes"):
+            os.makedirs(os.path.join(self.work, sub), exist_ok=True)
+        self.start = time.time()
+
+    def log(self, text):
+        print("%s: %s (%.0f s)" % (self.name, text, time.time() - self.start), flush=True)
+
+    def run(self, cmd):
+        p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        if p.returncode != 0:
+            sys.exit("%s: failed (%d): %s\n%s" % (self.name, p.returncode, " ".join(cmd), p.stdout))
+        return p.stdout
+
+    def scene_at_ior(self, scene, ior):
+        """A JSON scene with every part at `ior` (for scenes of one glass, e.g. diamond.json),
+        written into the work folder with absolute mesh paths."""
+        src = os.path.join(ROOT, scene)
+        doc = json.load(open(src))
+        for part in doc["parts"]:
+            part["mesh"] = os.path.join(os.path.dirname(src), part["mesh"])
+            part["ior"] = ior
+        base = os.path.splitext(os.path.basename(scene))[0]
+        out = os.path.join(self.work, "scenes", "%s_ior%g.json" % (base, ior))
+        with open(out, "w") as f:
+            json.dump(doc, f, indent=1)
+        return out
+
+    def wait_for_other_baker(self, out):
+        """Another study running at the same time may be baking the same file: wait for that
+        shrefract-bake process (found by its -o OUT argument) rather than bake twice."""
+        while True:
+            pids = []
+            for entry in glob.glob("/proc/[0-9]*/cmdline"):
+                try:
+                    argv = open(entry, "rb").read().split(b"\0")
+                except OSError:
+                    continue
+                if any(a.endswith(b"shrefract-bake") for a in argv[:1]) and out.encode() in argv:
+                    pids.append(entry.split("/")[2])
+            if not pids:
+                return
+            self.log("waiting for process %s, which is baking %s" % (pids[0], os.path.basename(out)))
+            time.sleep(15)
+
+    @staticmethod
+    def own_ior(scene):
+        """The index a scene is baked at without --ior: a JSON scene's first part's, else 1.5."""
+        if scene.endswith(".json"):
+            return json.load(open(os.path.join(ROOT, scene)))["parts"][0]["ior"]
+        return 1.5
+
+    def bake(self, name, scene, options, ior=None):
+        """Bakes `scene` (relative to the repository) unless the work folder has it. `ior`
+        replaces the index: --ior for a mesh, every part's for a JSON scene."""
+        if ior is not None and abs(ior - self.own_ior(scene)) < 1e-9:
+            ior = None  # the scene's own index: the plain bake, shared with other studies
+        tag = name if ior is None else "%s_ior%g" % (name, ior)
+        out = os.path.join(self.work, "bakes", tag + ".shrefract.exr")
+        meta = out + ".json"
+        self.wait_for_other_baker(out)
+        if os.path.exists(out) and not os.path.exists(meta):
+            # Made by an earlier run that stopped before writing its notes (the bake itself is
+            # written to a temporary name and renamed only when complete).
+            with open(meta, "w") as f:
+                json.dump({"scene": scene, "options": options, "ior": ior, "seconds": None}, f)
+        if not os.path.exists(out):
+            src = os.path.join(ROOT, scene)
+            extra = []
+            if ior is not None:
+                if scene.endswith(".json"):
+                    src = self.scene_at_ior(scene, ior)
+                else:
+                    extra = ["--ior", "%g" % ior]
+            t0 = time.time()
+            text = self.run([self.exe["bake"], src, "-o", out, "--threads", str(self.args.threads)] +
+                            options + extra)
+            seconds = time.time() - t0
+            with open(meta, "w") as f:
+                json.dump({"scene": scene, "options": options, "ior": ior, "seconds": seconds,
+                           "summary": text[-2000:]}, f, indent=1)
+            self.log("baked %s in %.0f s" % (tag, seconds))
+        return out
+
+    def render(self, bake, tag, camera, env="courtyard", method="sh", extra=(), size=None):
+        """Renders one evaluation buffer; returns its path, ms per frame and GPU memory (MB)."""
+        size = size or self.args.size
+        out = os.path.join(self.work, "renders", tag + ".exr")
+        text = self.run([self.exe["render"], bake, "--env",
+                         os.path.join(ROOT, "data", "envmaps", env + ".exr"), "--camera",
+                         "orbit:" + camera, "--size", "%dx%d" % (size, size), "--method", method,
+                         "--backend", self.args.backend, "--frames", str(self.args.frames),
+                         "--dirs", out] + list(extra) +
+                        (["--spp", str(self.args.spp)] if method == "raytrace" and self.args.spp > 1 else []))
+        ms = re.search(r"ms per frame \(\w+\): ([0-9.]+)", text)
+        mb = re.search(r"GPU memory: ([0-9.]+) MB(?: \+ bracketing bake ([0-9.]+) MB)?", text)
+        memory = None
+        if mb:
+            memory = float(mb.group(1)) + (float(mb.group(2)) if mb.group(2) else 0.0)
+        return {"path": out, "ms": float(ms.group(1)) if ms else None, "memoryMB": memory}
+
+    def compare(self, ref, test, tag):
+        """shrefract-eval image: angular error, coverage, PSNR, SSIM of `test` against `ref`."""
+        report = os.path.join(self.work, "reports", tag + ".json")
+        self.run([self.exe["eval"], "image", "--ref", ref, "--test", test, "--json", report])
+        with open(report) as f:
+            return json.load(f)
+
+    def montage(self, inputs, labels, png, errors=False):
+        self.run([self.exe["eval"], "montage"] + list(inputs) + ["--labels"] + list(labels) +
+                 (["--errors"] if errors else []) + ["--out", png])
+
+
+def summary(r):
+    """The numbers a table shows of one comparison."""
+    a = r["angleDeg"]
+    out = {"median": a.get("median"), "p95": a.get("p95"), "mean": a.get("mean"),
+           "psnr": r["psnr"], "ssim": r["ssim"], "mismatch": r["coverage"]["mismatch"],
+           "covered": r["coverage"]["ref"]}
+    # PSNR over the object's pixels alone: the background is the same environment lookup in both
+    # (identical to 125 dB) except at a multi-sample reference's anti-aliased silhouette, so the
+    # squared error is the object's and MSE_object = MSE_frame * pixels / covered. The frame's PSNR also measures how much of the
+    # frame the object fills; this one does not.
+    pixels = r.get("pixels") or (r.get("width", 0) * r.get("height", 0))
+    if pixels and out["covered"]:
+        out["psnrObject"] = r["psnr"] - 10.0 * math.log10(pixels / out["covered"])
+    return out
+
+
+def write_section(name, owner, body):
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import docsections
+    docsections.write_section(os.path.join(ROOT, "docs", "results.md"), name, owner, body)
+
+
+def write_json(name, doc):
+    """docs/NAME.json: every number a study measured, beside docs/results.json."""
+    with open(os.path.join(ROOT, "docs", name + ".json"), "w") as f:
+        json.dump(doc, f, indent=1)
+        f.write("\n")

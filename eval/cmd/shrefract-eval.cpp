@@ -165,7 +165,7 @@ int main(int argc, char** argv) {
                                                       readEvalBuffer(channels[2])));
             outputs.commit();
             std::printf("composed -> %s\n", composed.c_str());
-            return int(cli::kOk);
+            return cli::kOk;
         }
         if (mont->parsed()) {
             const std::string stagedPng = outputs.add(outPng);

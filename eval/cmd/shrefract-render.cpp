@@ -14,6 +14,7 @@
 #include <CLI/CLI.hpp>
 
 #include "common/cli/cli.h"
+#include "common/decompress.h"
 #include "common/error.h"
 #include "common/evalbuffer.h"
 #include "common/output.h"
@@ -341,8 +342,8 @@ int main(int argc, char** argv) {
                                 ior.z, bake.ior(),
                                 bracket ? " and the bracketing bake's" : " and the straight path");
                 }
-                std::printf("bake: order %d, %d samples, %d triangles, rho %dx%d; using order %d, "
-                            "%d decompression pass(es), preset %s, path %s, decompression %s, "
+                std::printf("bake: order %d, %d samples, %d triangles, %s layout, %s %dx%d; using "
+                            "order %d, %d decompression pass(es), preset %s, path %s, decompression %s, "
                             "shading %s; GPU memory %.2f MB\n",
                             bake.order(), bake.sampleCount(), bake.triangleCount(),
                             bake.layout().c_str(), bake.layout() == "joining" ? "rho" : "atlas",

@@ -91,8 +91,8 @@ glm::vec3 sampleCubeLod(const PrefilteredCube& cube, glm::vec3 d, float lod) {
     return t > 0.0f ? glm::mix(a, sampleCube(cube.levels[size_t(l1)], d), t) : a;
 }
 
-float spreadSigma(float resultant, float scale, float full) {
-    const float r = std::clamp(resultant / full, 1e-4f, 1.0f);
+float spreadSigma(float resultant, float scale) {
+    const float r = std::clamp(resultant, 1e-4f, 1.0f);
     if (r >= 1.0f) return 0.0f;
     const float kappa = r * (3.0f - r * r) / (1.0f - r * r);
     return scale / std::sqrt(kappa);

@@ -38,9 +38,8 @@ glm::vec3 sampleCubeLod(const PrefilteredCube& cube, glm::vec3 d, float lod);
 
 // The width (radians) of the vMF lobe whose mean resultant length is `resultant`: the length
 // of the unnormalized SH reconstruction of a unit exit direction, which falls below 1 where the
-// mapping scatters, divided by `full` (the length counted as fully coherent). kappa(R) =
-// R (3 - R^2) / (1 - R^2) (Banerjee et al. 2005), sigma = scale / sqrt(kappa); 0 at R >= 1, very
-// wide as R -> 0. shading.glsl spreadSigma() is the twin.
-float spreadSigma(float resultant, float scale = 1.0f, float full = 1.0f);
+// mapping scatters. kappa(R) = R (3 - R^2) / (1 - R^2) (Banerjee et al. 2005), sigma =
+// scale / sqrt(kappa); 0 at R >= 1, very wide as R -> 0. shading.glsl spreadSigma() is the twin.
+float spreadSigma(float resultant, float scale = 1.0f);
 
 }  // namespace shrefract

@@ -23,7 +23,6 @@ uniform bool uToneMap;
 uniform float uExposure;
 uniform bool uSpread;
 uniform float uSpreadScale;     // lobe width factor on spreadSigma()
-uniform float uSpreadFull;      // reconstruction length counted as fully coherent
 uniform float uFootprintScale;  // factor on the screen-space turn of a direction per pixel
 in vec3 vPosition;
 in vec3 vNormal;
@@ -43,7 +42,7 @@ void main() {
     vec3 exitWorld = resultant > 1e-10 ? normalize(uModelRotation * (r.xyz / resultant)) : -v;
     float exitSigma = 0.0, reflectSigma = 0.0;
     if (uSpread) {
-        float spread = spreadSigma(resultant, uSpreadScale, uSpreadFull);
+        float spread = spreadSigma(resultant, uSpreadScale);
         float footprint = footprintSigma(exitWorld, uFootprintScale);
         exitSigma = sqrt(spread * spread + footprint * footprint);
         reflectSigma = footprintSigma(reflect(-v, n), uFootprintScale);

@@ -28,7 +28,6 @@ uniform bool uToneMap;
 uniform float uExposure;
 uniform bool uSpread;
 uniform float uSpreadScale;
-uniform float uSpreadFull;
 uniform float uFootprintScale;
 in vec3 vPosition;
 in vec3 vNormal;
@@ -76,7 +75,7 @@ void main() {
         vec3 e = blendDirections(a, b, uBlend[k]);
         float sigma = 0.0;
         if (uSpread) {
-            float spread = spreadSigma(mix(resA, resB, uBlend[k]), uSpreadScale, uSpreadFull);
+            float spread = spreadSigma(mix(resA, resB, uBlend[k]), uSpreadScale);
             float footprint = footprintSigma(e, uFootprintScale);
             sigma = sqrt(spread * spread + footprint * footprint);
         }

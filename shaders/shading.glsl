@@ -23,10 +23,9 @@ vec3 environment(vec3 d, float sigma) {
 }
 
 // common/prefilter.h spreadSigma: the width (radians) of the vMF lobe whose mean resultant
-// length is r / full (r the length of the SH reconstruction of a unit exit direction, full the
-// length counted as fully coherent), times scale.
-float spreadSigma(float r, float scale, float full) {
-    r = clamp(r / full, 1e-4, 1.0);
+// length is r (the length of the SH reconstruction of a unit exit direction), times scale.
+float spreadSigma(float r, float scale) {
+    r = clamp(r, 1e-4, 1.0);
     if (r >= 1.0) return 0.0;
     float kappa = r * (3.0 - r * r) / (1.0 - r * r);
     return scale * inversesqrt(kappa);

@@ -105,9 +105,6 @@ int main(int argc, char** argv) {
         ->capture_default_str()->check(CLI::IsMember({"spread", "sharp"}));
     app.add_option("--spread-scale", sh.spreadScale, "sh, spread shading: lobe width factor")
         ->capture_default_str()->check(CLI::Range(0.0f, 100.0f));
-    app.add_option("--spread-full", sh.spreadFull,
-                   "sh, spread shading: reconstruction length counted as fully coherent")
-        ->capture_default_str()->check(CLI::Range(0.1f, 2.0f));
     app.add_option("--footprint-scale", sh.footprintScale, "sh, spread shading: screen footprint factor")
         ->capture_default_str()->check(CLI::Range(0.0f, 100.0f));
     app.add_flag("--half-weights", sh.halfWeights, "sh: upload float32 weights as RGBA16F");

@@ -727,7 +727,6 @@ void Refractor::draw(const glm::mat4& view, const glm::mat4& projection, const g
     setFloat(p, "uExposure", m.options.exposure);
     setInt(p, "uSpread", m.spread ? 1 : 0);
     setFloat(p, "uSpreadScale", m.options.spreadScale);
-    setFloat(p, "uSpreadFull", m.options.spreadFull);
     setFloat(p, "uFootprintScale", m.options.footprintScale);
     useEnvironment(p, environment, 0);
     if (m.ior.active)

@@ -144,9 +144,6 @@ struct RefractorOptions {
     // "sharp": the paper's single lookup along the exit direction (docs/runtime.md).
     std::string shading = "spread";
     float spreadScale = 1.0f;       // lobe width factor (spread shading)
-    // The reconstruction length counted as fully coherent (spread shading): the SH of even a
-    // smooth mapping come out a little short, and their length is divided by this first.
-    float spreadFull = 1.0f;
     float footprintScale = 0.5f;    // screen-space footprint factor (spread shading)
     // Chart layouts (isolated, uv; paper §5.2): gutter rings filled around the charts by
     // dilation (-1: the bake's gutter; 0: none), and whether gutter texels next to a smooth seam

@@ -26,53 +26,6 @@ double secondsSince(Clock::time_point t0) {
     return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-// The mean over the sample's footprint (--footprint-samples N > 1): N - 1 points along the
-// segments to its grid neighbours (listed after the sample itself), spread evenly over them, at
-// a quarter and two fifths of the way, traced with the same object-space view directions
-// omegas[j]; paths[j] becomes the mean exit vector and length (its flags stay the sample's).
-// Returns the rays traced.
-size_t averageOverFootprint(const Tracer& tracer, const SurfaceLayout& L, size_t i, int footprintSamples,
-                            bool coherent, const std::vector<glm::vec3>& omegas, std::vector<PathResult>& paths) {
-    thread_local std::vector<glm::vec3> sumExit, seen;
-    thread_local std::vector<float> sumLength;
-    thread_local std::vector<int> used;
-    thread_local std::vector<uint32_t> visible;
-    thread_local std::vector<PathResult> traced;
-    const size_t J = omegas.size();
-    sumExit.resize(J), sumLength.resize(J), used.assign(J, 1);
-    for (size_t j = 0; j < J; ++j) sumExit[j] = paths[j].exit, sumLength[j] = paths[j].length;
-    const uint32_t first = L.neighbourOffset[i] + 1, others = L.neighbourCount[i] - 1;
-    const uint32_t extra = uint32_t(footprintSamples - 1);
-    size_t rays = 0;
-    for (int f = 1; f < footprintSamples && others > 0; ++f) {
-        const uint32_t nb = L.neighbourIndex[first + (uint32_t(f - 1) * others) / extra];
-        const float t = f % 2 ? 0.25f : 0.4f;
-        const glm::vec3 pf = glm::mix(L.position[i], L.position[nb], t);
-        const glm::vec3 nf = glm::normalize(glm::mix(L.normal[i], L.normal[nb], t));
-        // The directions that see the point from above (elsewhere the view is below it).
-        visible.clear(), seen.clear();
-        for (size_t j = 0; j < J; ++j)
-            if (glm::dot(nf, omegas[j]) > 0.0f) visible.push_back(uint32_t(j)), seen.push_back(omegas[j]);
-        traced.resize(seen.size());
-        if (coherent)
-            tracer.traceCoherent(pf, nf, seen.data(), seen.size(), L.part[i], traced.data());
-        else
-            for (size_t k = 0; k < seen.size(); ++k) traced[k] = tracer.trace(pf, nf, seen[k], L.part[i]);
-        for (size_t k = 0; k < visible.size(); ++k) {
-            const uint32_t j = visible[k];
-            sumExit[j] += traced[k].exit;
-            sumLength[j] += traced[k].length;
-            rays += traced[k].rays;
-            ++used[j];
-        }
-    }
-    for (size_t j = 0; j < J; ++j) {
-        paths[j].exit = sumExit[j] / float(used[j]);
-        paths[j].length = sumLength[j] / float(used[j]);
-    }
-    return rays;
-}
-
 }  // namespace
 
 const char* ToString(Fit fit) {
@@ -238,8 +191,6 @@ SliceResult BakePlan::bakeSlice(size_t beginBatch, size_t endBatch, const SliceP
                 } else {
                     for (int q = 0; q < J; ++q) paths[q] = tracer.trace(L.position[i], L.normal[i], omegas[q], L.part[i]);
                 }
-                if (opt.footprintSamples > 1)
-                    localRays += averageOverFootprint(tracer, L, i, opt.footprintSamples, opt.coherent, omegas, paths);
                 for (int q = 0; q < J; ++q) {
                     const PathResult& p = paths[q];
                     const int j = int(order[q]);
@@ -343,7 +294,6 @@ nlohmann::json BakePlan::manifest(const BakeStats& stats) const {
         {"filterWidth", opt_.filterWidth},
         {"fit", ToString(opt_.fit)},
         {"fitWeighting", opt_.fit == Fit::Weighted ? opt_.weighting.ToString() : ""},
-        {"footprintSamples", opt_.footprintSamples},
         {"branch", opt_.trace.branch == Branch::Fresnel ? "fresnel" : "transmit"},
         {"maxBounces", opt_.trace.maxBounces},
         {"tracer", opt_.coherent ? "coherent" : "scalar"},

@@ -55,13 +55,7 @@ struct BakeOptions {
     TraceOptions trace;
     bool coherent = true;    // trace a sample's paths as Embree streams (Tracer::traceCoherent)
     double filterWidth = 0.0;  // semi-Gaussian width in bands; <= 0: none
-    Fit fit = Fit::Projection;
-    // Rays per (sample, direction): 1 traces the sample itself; N > 1 also traces N - 1 points
-    // around it on the surface (along the segments to its grid neighbours, up to halfway) with
-    // the same world-space view direction and stores the mean exit vector and length: the SH
-    // then carry the mapping averaged over the sample's footprint, whose length below 1 is the
-    // spread spread shading turns into a lobe (docs/bake.md "Footprint samples").
-    int footprintSamples = 1;
+    Fit fit = Fit::Weighted;  // the default by the charts (docs/bake.md "Fits"); the paper: Projection
     FitWeighting weighting;    // for Fit::Weighted
     Precision precision = Precision::F32;
     int threads = 0;         // 0: all cores

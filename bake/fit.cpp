@@ -26,14 +26,11 @@ FitWeighting FitWeighting::parse(const std::string& text, const std::string& wha
     const bool ok = bool(in >> w.flagged >> c[0] >> w.disagreeDeg >> c[1] >> w.disagreeing >> c[2] >>
                          w.trimDeg >> c[3] >> w.trimmed >> c[4] >> w.trimPasses);
     if (ok && in >> c[5]) in >> w.ridge;
-    char c6 = 0, c7 = 0;
-    if (ok && in >> c6) in >> w.meanRadius >> c7 >> w.meanWeight;
     const bool colons = std::all_of(c, c + 5, [](char x) { return x == ':'; });
     if (!ok || !colons || !in.eof() || !(w.flagged > 0 && w.flagged <= 1) ||
         !(w.disagreeing > 0 && w.disagreeing <= 1) || !(w.trimmed > 0 && w.trimmed <= 1) ||
-        w.trimPasses < 0 || w.trimPasses > 8 || !(w.ridge >= 0) || !(w.disagreeDeg >= 0) || !(w.trimDeg > 0) ||
-        (c6 && (c6 != ':' || c7 != ':' || w.meanRadius < 0 || w.meanRadius > 16 || !(w.meanWeight > 0 && w.meanWeight <= 1))))
-        throw InputError(what + ": expected FLAGGED:DEG:DISAGREEING:TRIMDEG:TRIMMED:PASSES[:RIDGE[:MEANRADIUS:MEANWEIGHT]] "
+        w.trimPasses < 0 || w.trimPasses > 8 || !(w.ridge >= 0) || !(w.disagreeDeg >= 0) || !(w.trimDeg > 0))
+        throw InputError(what + ": expected FLAGGED:DEG:DISAGREEING:TRIMDEG:TRIMMED:PASSES[:RIDGE] "
                                 "with factors in (0, 1], passes 0..8, got '" + text + "'");
     return w;
 }
@@ -42,8 +39,7 @@ std::string FitWeighting::ToString() const {
     std::ostringstream os;
     os << flagged << ":" << disagreeDeg << ":" << disagreeing << ":" << trimDeg << ":" << trimmed
        << ":" << trimPasses;
-    if (ridge > 0 || meanRadius > 0) os << ":" << ridge;
-    if (meanRadius > 0) os << ":" << meanRadius << ":" << meanWeight;
+    if (ridge > 0) os << ":" << ridge;
     return os.str();
 }
 
@@ -91,32 +87,9 @@ void WeightedFitter::confidence(const PathResult* paths, float* c) const {
         }
 }
 
-void WeightedFitter::fit(const Eigen::Ref<const Eigen::MatrixXf>& Rin, const float* cin,
+void WeightedFitter::fit(const Eigen::Ref<const Eigen::MatrixXf>& R, const float* c,
                          Eigen::Ref<Eigen::MatrixXf> W) const {
     const int J = directions();
-    // Mean targets for the low-confidence directions (FitWeighting::meanRadius).
-    Eigen::MatrixXf Rmean;
-    std::vector<float> cmean;
-    const Eigen::MatrixXf* Rp = nullptr;
-    const float* c = cin;
-    if (weighting_.meanRadius > 0) {
-        Rmean = Rin;
-        cmean.assign(cin, cin + J);
-        const int r = weighting_.meanRadius, nT = grid_.nTheta, nP = grid_.nPhi;
-        for (int j = 0; j < J; ++j) {
-            if (cin[j] >= 1.0f) continue;
-            const int i = j / nP, k = j % nP;
-            Eigen::RowVector4f sum = Eigen::RowVector4f::Zero();
-            int n = 0;
-            for (int ii = std::max(0, i - r); ii <= std::min(nT - 1, i + r); ++ii)
-                for (int dk = -r; dk <= r; ++dk, ++n) sum += Rin.row(ii * nP + ((k + dk) % nP + nP) % nP);
-            Rmean.row(j) = sum / float(n);
-            cmean[j] = weighting_.meanWeight;
-        }
-        Rp = &Rmean;
-        c = cmean.data();
-    }
-    const Eigen::Ref<const Eigen::MatrixXf> R = Rp ? Eigen::Ref<const Eigen::MatrixXf>(*Rp) : Rin;
     solve(R, c, W);
     const float cosTrim = std::cos(weighting_.trimDeg * float(M_PI) / 180.0f);
     std::vector<float> ct(c, c + J);

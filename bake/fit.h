@@ -36,16 +36,10 @@ struct FitWeighting {
     float trimmed = 0.03f;      // ...c_j times this...
     int trimPasses = 1;         // ...and the sample fitted again, this many times (0: none)
     float ridge = 0.0f;         // Tikhonov weight on band l: ridge * l (l + 1)
-    // > 0: a direction with c_j < 1 (flagged or disagreeing) is fitted, at weight `meanWeight`, to
-    // the mean of r over the (2 meanRadius + 1)^2 grid directions around it (theta clamped, phi
-    // wrapping) instead of to its own r: where the mapping scatters the bands then carry its local
-    // mean, whose length below 1 is the spread that spread shading turns into a lobe.
-    int meanRadius = 0;
-    float meanWeight = 0.3f;
 
     // No weighting at all: the plain least-squares fit.
     static FitWeighting none();
-    // "FLAGGED:DEG:DISAGREEING:TRIMDEG:TRIMMED:PASSES[:RIDGE[:MEANRADIUS:MEANWEIGHT]]" (the
+    // "FLAGGED:DEG:DISAGREEING:TRIMDEG:TRIMMED:PASSES[:RIDGE]" (the
     // defaults are "0.3:30:0.01:20:0.03:1"); throws InputError naming `what` on bad text.
     static FitWeighting parse(const std::string& text, const std::string& what = "--fit-weighting");
     std::string ToString() const;

@@ -86,7 +86,6 @@ BakeOptions optionsOf(const json& id) {
     if (o.fit == Fit::Weighted) o.weighting = FitWeighting::parse(id.value("fitWeighting", ""), "fitWeighting");
     o.trace.branch = id.value("branch", "") == "transmit" ? Branch::Transmit : Branch::Fresnel;
     o.trace.maxBounces = id.value("maxBounces", 32);
-    o.footprintSamples = id.value("footprintSamples", 1);
     o.coherent = id.value("tracer", "coherent") == "coherent";
     o.cacheDir = "";
     return o;

@@ -400,8 +400,9 @@ std::string inconsistency(const BakeData& d) {
                        r.c, ") but there are only ", N);
     }
     // Every triangle's grid positions hold its samples, and the texels past its hypotenuse its
-    // corrections: what the runtime and queryBake look up (SurfaceLayout::sampleAt).
-    for (int t = 0; t < L.triangleCount; ++t) {
+    // corrections: what the runtime and queryBake look up (SurfaceLayout::sampleAt). Chart
+    // layouts have no triangle blocks (chartInconsistency checks their atlas).
+    for (int t = 0; t < (L.isChartLayout() ? 0 : L.triangleCount); ++t) {
         for (int j = 0; j <= L.rate + 1; ++j)
             for (int i = 0; i + j <= L.rate + 1; ++i) {
                 const bool correction = i + j == L.rate + 1;

@@ -77,10 +77,6 @@ int main(int argc, char** argv) {
     app.add_option("--fit-weighting", weighting,
                    "--fit weighted: FLAGGED:DEG:DISAGREEING:TRIMDEG:TRIMMED:PASSES (bake/fit.h)")
         ->capture_default_str();
-    app.add_option("--footprint-samples", opt.footprintSamples,
-                   "rays per (sample, direction), averaged over the sample's footprint on the surface "
-                   "(1: the sample alone)")
-        ->capture_default_str()->check(CLI::Range(1, 64));
     app.add_option("--precision", precision, "weight storage: f32, f16 or u8")->capture_default_str()
         ->check(CLI::IsMember({"f32", "f16", "u8"}));
     app.add_option("--threads", opt.threads, "worker threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));

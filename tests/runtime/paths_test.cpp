@@ -227,8 +227,8 @@ TEST_P(Paths, SpreadLookupMatchesItsCpuTwin) {
         o.footprintScale = 0.0f;
         auto r = Refractor::create(makeBake(data), o);
         const RenderedFrame f = renderFrame(*r, env, Camera::orbit(30, 20, 3.5f), 48, 48);
-        const glm::vec3 expect =
-            sampleCubeLod(cube, e, lodForSigma(spreadSigma(R), env.faceSize(), env.levels()));
+        const float sigma = spreadSigma(R, o.spreadScale);  // the default width factor
+        const glm::vec3 expect = sampleCubeLod(cube, e, lodForSigma(sigma, env.faceSize(), env.levels()));
         double worst = 0;
         size_t covered = 0;
         // Pixels two or more from the silhouette: there the interpolated normal faces the viewer
@@ -248,7 +248,7 @@ TEST_P(Paths, SpreadLookupMatchesItsCpuTwin) {
             for (int c = 0; c < 3; ++c) worst = std::max(worst, double(std::abs(f.color[i + c] - expect[c]) / expect[c]));
         }
         std::printf("[%s] R %.2f: lod %.2f, max relative |GL - CPU| %.2g over %zu px\n", ToString(GetParam()), R,
-                    lodForSigma(spreadSigma(R), env.faceSize(), env.levels()), worst, covered);
+                    lodForSigma(sigma, env.faceSize(), env.levels()), worst, covered);
         EXPECT_GT(covered, 100u);
         EXPECT_LT(worst, 3e-3) << "R " << R;
     }

@@ -143,8 +143,8 @@ struct RefractorOptions {
     // averaged over a lobe of a prefiltered cube map, widened by the screen-space footprint;
     // "sharp": the paper's single lookup along the exit direction (docs/runtime.md).
     std::string shading = "spread";
-    float spreadScale = 1.0f;       // lobe width factor (spread shading)
-    float footprintScale = 0.5f;    // screen-space footprint factor (spread shading)
+    float spreadScale = 0.5f;       // lobe width factor (spread shading; docs/runtime.md)
+    float footprintScale = 0.3f;    // screen-space footprint factor (spread shading)
     // Chart layouts (isolated, uv; paper §5.2): gutter rings filled around the charts by
     // dilation (-1: the bake's gutter; 0: none), and whether gutter texels next to a smooth seam
     // take the values across the cut instead (seam-aware filling, docs/runtime.md).

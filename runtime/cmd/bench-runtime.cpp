@@ -1,5 +1,5 @@
 // shrefract-bench-runtime: per-frame cost of the runtime on one bake, as JSON (run by
-// scripts/bench-runtime). For each preset x order x viewport:
+// scripts/bench-runtime). For each interpolation path x preset x order x viewport:
 //   - throughput: stage timer queries off, median wall ms of a whole frame (update + draw +
 //     glFinish) and its GPU time (one GL_TIME_ELAPSED query around the frame);
 //   - breakdown: stage timer queries on (each stage finished inside its query), median ms of
@@ -7,7 +7,9 @@
 //   - GPU texture bytes the refractor allocated with only bands 0..L uploaded (paper Fig. 12);
 // and, in the same run, a baseline: the same mesh drawn with one environment lookup per pixel
 // (refracted view direction at the front face, no decompression), for the ratio
-// runtime frame / plain environment-mapped draw.
+// runtime frame / plain environment-mapped draw, and an empty frame (the target cleared and
+// finished, nothing drawn): what every frame pays before it draws anything. --memory-bakes adds
+// the GPU memory per part of other bakes of the same mesh (f16, u8) on every path.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -84,6 +86,20 @@ FrameTimes timeFrames(OffscreenTarget& target, int warmup, int frames, bool gpuQ
     return {median(wall), median(gpu)};
 }
 
+nlohmann::json memoryJson(const GpuMemory& m) {
+    return {{"weights", m.weights},       {"samples", m.samples},
+            {"rho", m.rho},               {"mesh", m.mesh},
+            {"neighbours", m.neighbours}, {"targets", m.targets},
+            {"total_bytes", m.total()},   {"total_MB", m.total() / 1e6}};
+}
+
+// "direct:vertex" -> options.path "direct", options.decompression "vertex".
+void applyPath(const std::string& text, RefractorOptions& o) {
+    const size_t colon = text.find(':');
+    o.path = text.substr(0, colon);
+    o.decompression = colon == std::string::npos ? "auto" : text.substr(colon + 1);
+}
+
 std::vector<std::string> split(const std::string& text) {
     std::vector<std::string> out;
     std::stringstream ss(text);
@@ -98,14 +114,21 @@ std::vector<std::string> split(const std::string& text) {
 int main(int argc, char** argv) {
     CLI::App app{"Per-frame cost of the shrefract runtime, as JSON"};
     std::string bakePath, envPath, orders = "1,4,8", sizes = "1024x1024,1350x1100",
-                                      presets = "2006,modern", backend = "egl", jsonPath;
+                                      presets = "2006,modern", backend = "egl", jsonPath,
+                                      paths = "rho,direct", memoryBakes;
     int frames = 15, warmup = 3;
-    bool smoothing = true;
+    bool smoothing = false;  // the runtime's default (vertex decompression needs it off)
     app.add_option("bake", bakePath, "NAME.shrefract.exr")->required();
     app.add_option("--env", envPath, "lat-long environment EXR")->required();
     app.add_option("--orders", orders, "SH orders used, comma-separated")->capture_default_str();
     app.add_option("--sizes", sizes, "viewports WxH, comma-separated")->capture_default_str();
     app.add_option("--presets", presets, "shader limit presets")->capture_default_str();
+    app.add_option("--paths", paths,
+                   "interpolation paths, comma-separated: rho, direct (auto decompression), "
+                   "direct:vertex, direct:texture")->capture_default_str();
+    app.add_option("--memory-bakes", memoryBakes,
+                   "other bakes of the same mesh (e.g. f16, u8), comma-separated: GPU memory per "
+                   "part on every path at their full order");
     app.add_option("--backend", backend, "egl | osmesa")->capture_default_str();
     app.add_option("--frames", frames, "timed frames per measurement")->capture_default_str();
     app.add_option("--warmup", warmup, "untimed frames first")->capture_default_str();
@@ -176,9 +199,23 @@ int main(int argc, char** argv) {
         }
         out["baseline"] = baseline;
 
+        // An empty frame per viewport: the target bound (cleared) and finished, nothing drawn.
+        nlohmann::json empty = nlohmann::json::object();
+        for (glm::ivec2 vp : viewports) {
+            OffscreenTarget target(vp.x, vp.y);
+            FrameTimes t = timeFrames(
+                target, warmup, frames, true, [](glm::vec3, const glm::mat4&, const glm::mat4&) {},
+                [] {});
+            const std::string key = std::to_string(vp.x) + "x" + std::to_string(vp.y);
+            empty[key] = {{"frame_wall_ms", t.wall}, {"frame_gpu_ms", t.gpu}};
+            std::fprintf(stderr, "empty frame %s: %.2f ms\n", key.c_str(), t.wall);
+        }
+        out["empty_frame"] = empty;
+
         nlohmann::json runs = nlohmann::json::array();
         nlohmann::json memory = nlohmann::json::object();
-        for (const std::string& preset : split(presets)) {
+        for (const std::string& pathText : split(paths)) {
+          for (const std::string& preset : split(presets)) {
             for (const std::string& orderText : split(orders)) {
                 const int order = std::stoi(orderText);
                 if (order > bake.order()) {
@@ -187,18 +224,22 @@ int main(int argc, char** argv) {
                     continue;
                 }
                 RefractorOptions options;
+                applyPath(pathText, options);
                 options.preset = preset;
                 options.order = order;
                 options.maxOrder = order;  // upload only what this order uses (Figure 12)
                 options.smoothing = smoothing;
                 options.loader = context->loader();
-                auto refractor = Refractor::create(bake, options);
-                const GpuMemory& m = refractor->memory();
-                memory[std::to_string(order)] = {
-                    {"weights", m.weights},       {"samples", m.samples},
-                    {"rho", m.rho},               {"neighbours", m.neighbours},
-                    {"targets", m.targets},       {"total_bytes", m.total()},
-                    {"total_MB", m.total() / 1e6}, {"total_MiB", m.total() / 1048576.0}};
+                std::unique_ptr<Refractor> refractor;
+                try {
+                    refractor = Refractor::create(bake, options);
+                } catch (const std::invalid_argument& e) {  // e.g. vertex decompression at 2006
+                    std::fprintf(stderr, "skipping %s %s order %d: %s\n", pathText.c_str(),
+                                 preset.c_str(), order, e.what());
+                    continue;
+                }
+                memory[pathText + " " + preset + " " + std::to_string(order)] =
+                    memoryJson(refractor->memory());
                 for (size_t v = 0; v < viewports.size(); ++v) {
                     glm::ivec2 vp = viewports[v];
                     OffscreenTarget target(vp.x, vp.y);
@@ -218,6 +259,8 @@ int main(int argc, char** argv) {
                         for (int i = 0; i < 5; ++i) st[i].push_back(values[i]);
                     });
                     nlohmann::json run = {
+                        {"path", refractor->path()},
+                        {"decompression", refractor->decompression()},
                         {"preset", preset},
                         {"order", order},
                         {"viewport", std::to_string(vp.x) + "x" + std::to_string(vp.y)},
@@ -233,15 +276,54 @@ int main(int argc, char** argv) {
                           {"unpack", median(st[3])},
                           {"shade", median(st[4])}}},
                         {"frame_wall_ms_with_stage_timers", timed.wall}};
-                    std::fprintf(stderr, "%s order %d %dx%d: %.2f ms (x%.2f baseline)\n",
-                                 preset.c_str(), order, vp.x, vp.y, t.wall,
+                    std::fprintf(stderr, "%s %s order %d %dx%d: %.2f ms (x%.2f baseline)\n",
+                                 pathText.c_str(), preset.c_str(), order, vp.x, vp.y, t.wall,
                                  run["ratio_to_baseline"].get<double>());
                     runs.push_back(run);
                 }
             }
+          }
         }
         out["runs"] = runs;
-        out["memory_by_order"] = memory;
+        out["memory"] = memory;
+
+        // Ratios of the measured frames: direct over rho (modern preset), per order and viewport.
+        nlohmann::json ratios = nlohmann::json::array();
+        for (const auto& a : runs)
+            for (const auto& b : runs)
+                if (a["path"] == "direct" && b["path"] == "rho" && a["preset"] == "modern" &&
+                    b["preset"] == "modern" && a["order"] == b["order"] &&
+                    a["viewport"] == b["viewport"])
+                    ratios.push_back({{"order", a["order"]}, {"viewport", a["viewport"]},
+                                      {"decompression", a["decompression"]},
+                                      {"direct_over_rho", a["frame_wall_ms"].get<double>() /
+                                                              b["frame_wall_ms"].get<double>()}});
+        out["ratios"] = ratios;
+
+        // Memory of other bakes of the mesh (stored precisions), every path, full order.
+        nlohmann::json others = nlohmann::json::array();
+        for (const std::string& path : split(memoryBakes)) {
+            Bake other = loadBake(path);
+            for (const std::string& pathText : split(paths)) {
+                RefractorOptions options;
+                applyPath(pathText, options);
+                options.loader = context->loader();
+                std::unique_ptr<Refractor> r;
+                try {
+                    r = Refractor::create(other, options);
+                } catch (const std::invalid_argument&) {
+                    continue;
+                }
+                others.push_back({{"bake", path},
+                                  {"precision", other.data().manifest.value("precision", "")},
+                                  {"path", r->path()},
+                                  {"decompression", r->decompression()},
+                                  {"memory", memoryJson(r->memory())}});
+                std::fprintf(stderr, "%s %s: %.2f MB\n", path.c_str(), pathText.c_str(),
+                             r->memory().total() / 1e6);
+            }
+        }
+        out["memory_other_bakes"] = others;
 
         const std::string text = out.dump(2) + "\n";
         if (jsonPath.empty()) {

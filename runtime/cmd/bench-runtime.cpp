@@ -238,8 +238,7 @@ int main(int argc, char** argv) {
                                  preset.c_str(), order, e.what());
                     continue;
                 }
-                memory[pathText + " " + preset + " " + std::to_string(order)] =
-                    memoryJson(refractor->memory());
+
                 for (size_t v = 0; v < viewports.size(); ++v) {
                     glm::ivec2 vp = viewports[v];
                     OffscreenTarget target(vp.x, vp.y);
@@ -281,6 +280,9 @@ int main(int argc, char** argv) {
                                  run["ratio_to_baseline"].get<double>());
                     runs.push_back(run);
                 }
+                // After the frames: render targets are made on first use.
+                memory[pathText + " " + preset + " " + std::to_string(order)] =
+                    memoryJson(refractor->memory());
             }
           }
         }
@@ -314,6 +316,7 @@ int main(int argc, char** argv) {
                 } catch (const std::invalid_argument&) {
                     continue;
                 }
+                r->update(glm::vec3(0.0f, 0.0f, 3.0f));  // render targets are made on first use
                 others.push_back({{"bake", path},
                                   {"precision", other.data().manifest.value("precision", "")},
                                   {"path", r->path()},

@@ -84,8 +84,15 @@ struct Refractor::Impl {
     bool direct = false, spread = true;
     // Direct path: the SH may be evaluated in the shading's vertex shader (one pass, chosen or
     // "auto"); they are, unless smoothing (which needs D_mu in texture space) is on.
+    // "auto" evaluates in the vertex shader up to this order and in texture space above it:
+    // measured on llvmpipe (scripts/bench-runtime, docs/runtime.md), vertex decompression is
+    // 0.65x the rho path's frame at order 1 but 1.3-1.8x at orders 4 and 8, where the texture
+    // pass is 0.8-0.9x. Asked for explicitly, "vertex" holds at every order.
+    static constexpr int kAutoVertexMaxOrder = 1;
     bool vertexShAllowed = false, vertexShRequired = false;
-    bool vertexMode() const { return vertexShAllowed && !smoothing; }
+    bool vertexMode() const {
+        return vertexShAllowed && !smoothing && (vertexShRequired || order <= kAutoVertexMaxOrder);
+    }
     int muW = 0, muH = 0, rhoW = 0, rhoH = 0, listWidth = 1;
     ShaderLimits limits;
     ShForm form = ShForm::Auto;

@@ -101,7 +101,7 @@ RTCRayHit closestHit(RTCScene scene, RTCIntersectContext* ctx, glm::vec3 org, gl
 void intersect16(RTCScene scene, RTCIntersectContext* ctx, RTCRayHit* rays, size_t count) {
     for (size_t first = 0; first < count; first += 16) {
         RTCRayHit16 packet;
-        int valid[16];
+        alignas(64) int valid[16];  // Embree reads the mask with aligned vector loads
         const size_t lanes = std::min<size_t>(16, count - first);
         for (size_t l = 0; l < 16; ++l) {
             const RTCRay& r = rays[first + (l < lanes ? l : 0)].ray;

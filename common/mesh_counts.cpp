@@ -103,10 +103,14 @@ void checkOff(const std::string& path, const std::string& text) {
                                    "faces than its " + std::to_string(rest) + " bytes of data hold");
         return;
     }
-    if (t.empty()) {
-        if (!lines.next(&line)) throw inputError(path, "cut short: OFF without its counts");
-        t = tokens(line);
-    }
+    // OpenMesh reads the counts from the line after the keyword, never from the keyword's own
+    // line: counts there leave its counts unread and it reserves for garbage (found by the fuzzer:
+    // "OFF 0 0" asked for 4 GB).
+    if (!t.empty())
+        throw inputError(path, "could not parse: '" + line.substr(0, 40) + "': the vertex and face "
+                               "counts must stand on the line after " + key);
+    if (!lines.next(&line)) throw inputError(path, "cut short: OFF without its counts");
+    t = tokens(line);
     uint64_t nv = 0, nf = 0;
     if (t.size() < 2 || !isCount(t[0], &nv) || !isCount(t[1], &nf))
         throw inputError(path, "could not parse: no vertex and face counts after " + key);

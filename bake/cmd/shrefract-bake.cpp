@@ -107,211 +107,211 @@ int main(int argc, char** argv) {
     std::string checkpointDir;  // set once a checkpointed bake has begun
 
     return cli::run(app, kTool, argc, argv, [&] {
-      try {
-        // Stop cleanly on Ctrl-C or SIGTERM: the bake polls the flag, nothing is written.
-        opt.cancel = cli::cancelOnSignals();
-        opt.rate = rate;
-        opt.samples = samples;
-        opt.layout = parseLayoutKind(layout);
-        if (opt.layout != LayoutKind::Joining && rate > 0)
-            throw InputError("--rate is for --layout joining; chart layouts take --samples or --texels");
-        if (opt.layout == LayoutKind::Joining && !texels.empty())
-            throw InputError("--texels is for --layout isolated or uv");
-        if (opt.layout != LayoutKind::Joining && targetError > 0)
-            throw InputError("--target-error searches joining layouts only");
-        if (!texels.empty()) {
-            int w = 0, h = 0;
-            char x = 0, extra = 0;
-            const int got = std::sscanf(texels.c_str(), "%d%c%d%c", &w, &x, &h, &extra);
-            if (got == 1) h = w;
-            if (!((got == 1) || (got == 3 && (x == 'x' || x == 'X'))) || w < 1 || h < 1 ||
-                w > 16384 || h > 16384)
-                throw InputError("--texels: expected WxH or W (1 to 16384), got '" + texels + "'");
-            opt.charts.texels = {w, h};
-        }
-        opt.grid = parseGrid(grid, "--grid");
-        opt.trace.branch = branch == "transmit" ? Branch::Transmit : Branch::Fresnel;
-        opt.precision = parsePrecision(precision);
-        opt.fit = parseFit(fit);
-        opt.weighting = FitWeighting::parse(weighting);
-        opt.cacheDir = cache;
-        opt.coherent = tracer == "coherent";
-        ShardSlice slice;
-        if (!shardText.empty()) {
-            slice = parseShard(shardText, std::getenv("SLURM_ARRAY_TASK_ID"));
-            if (targetError > 0)
-                throw InputError("--target-error cannot be combined with --shard: run the search "
-                                 "once, then shard with the --order, --rate and --grid it chose");
-        }
-        if (workDir.empty()) workDir = output + ".work";
-        // Every output checked and staged before the work: a bad path fails now, not after an
-        // hour of tracing, and nothing appears under its name until all are complete.
-        OutputSet outputs;
-        const std::string stagedBake = outputs.add(output);
-        const std::string stagedReport = targetReport.empty() ? "" : outputs.add(targetReport);
-
-        Medium medium;
-        medium.ior = ior;
-        Scene scene = loadScene(input, medium);
-        for (const Part& p : scene.parts)
-            for (const std::string& w : p.report.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
-
-        if (targetError > 0) {
-            TargetSearchOptions topt;
-            topt.targetDeg = targetError;
-            if (!quiet) std::fprintf(stderr, "target-error: searching order, rate and grid on held-out pairs...\n");
-            TargetSearchResult t = searchTarget(scene, opt, topt);
-            const TargetCandidate& c = t.chosen;
-            const TargetCandidate& p = t.reference;
-            std::printf("target-error %.3g deg: %s order %d, rate %d, grid %s: median %.2f deg, p95 %.1f deg\n",
-                        targetError, t.reached ? "chose" : "NOT REACHED; most accurate is", c.order, c.rate,
-                        c.grid.ToString().c_str(), c.medianDeg, c.p95Deg);
-            std::printf("  paper's fixed model (order 8, rate %d, grid 32x64): median %.2f deg, %.1f MB of "
-                        "weights, %.3g paths\n", p.rate, p.medianDeg, p.weightBytes / 1e6, p.bakeCost);
-            std::printf("  chosen: %.1f MB of weights (%.2fx less), %.3g paths (%.2fx less)\n", c.weightBytes / 1e6,
-                        double(p.weightBytes) / std::max<size_t>(1, c.weightBytes), c.bakeCost,
-                        p.bakeCost / std::max(1.0, c.bakeCost));
-            if (!targetReport.empty()) writeFile(stagedReport, t.ToJson().dump(2) + "\n");
-            opt.order = c.order;
-            opt.rate = c.rate;
-            opt.grid = c.grid;
-        }
-
-        const bool tty = cli::stderrIsTerminal();
-        int lastDecile = -1;
-        if (!quiet) {
-            opt.progress = [&](const BakeProgress& p) {
-                double f = double(p.samplesDone) / std::max<size_t>(1, p.samplesTotal);
-                double rps = p.rays / std::max(1e-9, p.seconds);
-                // This run's pace over the samples it has done (not the resumed ones).
-                double g = double(p.samplesDone - p.samplesResumed) / std::max<size_t>(1, p.samplesTotal);
-                double eta = g > 0 ? p.seconds * (1 - f) / g : 0;
-                if (tty) {
-                    int filled = static_cast<int>(f * 30);
-                    std::fprintf(stderr, "\r[%-30s] %5.1f%%  %zu/%zu samples  %6.2f Mrays/s  ETA %s ",
-                                 std::string(filled, '#').c_str(), 100 * f, p.samplesDone,
-                                 p.samplesTotal, rps * 1e-6, cli::formatDuration(eta).c_str());
-                } else if (int(f * 10) > lastDecile) {
-                    lastDecile = int(f * 10);
-                    std::fprintf(stderr, "bake: %3.0f%% (%zu/%zu samples, %.2f Mrays/s, ETA %s)\n", 100 * f,
-                                 p.samplesDone, p.samplesTotal, rps * 1e-6, cli::formatDuration(eta).c_str());
-                }
-            };
-        }
-        if (opt.layout == LayoutKind::Joining && opt.rate == 0) {
-            // Say what --samples becomes: the smallest rate reaching it, usually more samples.
-            opt.rate = rateForSampleCount(scene, opt.samples);
-            const size_t n = joiningSampleCount(scene, opt.rate);
-            if (n != opt.samples)
-                cli::note(kTool, "--samples " + std::to_string(opt.samples) + ": rate " +
-                                     std::to_string(opt.rate) + " gives " + std::to_string(n) +
-                                     " unique samples (" +
-                                     (n > opt.samples ? "the smallest rate that reaches it"
-                                                      : "the largest rate; it cannot reach it") +
-                                     ")");
-        }
-
-        auto note = [&](const std::string& text) {
-            if (!quiet) std::fprintf(stderr, "%s%s\n", tty ? "\r" : "", text.c_str());
-        };
-        BakePlan plan(scene, opt, input);
-        for (const std::string& w : plan.chartStats().warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
-        if (!shardText.empty()) {
-            // One slice into a shard file, for shrefract-merge.
-            if (resume && fs::exists(output)) {
-                try {
-                    const ShardData old = readShard(output);
-                    if (shardMismatch(old, shardIdentity(plan), slice, plan.batchCount()).empty()) {
-                        std::printf("%s: slice %d of %d is already complete\n", output.c_str(),
-                                    slice.index, slice.count);
-                        return int(cli::kOk);
-                    }
-                } catch (const InputError& e) {
-                    note(std::string("baking it again: ") + e.what());
-                }
+        try {
+            // Stop cleanly on Ctrl-C or SIGTERM: the bake polls the flag, nothing is written.
+            opt.cancel = cli::cancelOnSignals();
+            opt.rate = rate;
+            opt.samples = samples;
+            opt.layout = parseLayoutKind(layout);
+            if (opt.layout != LayoutKind::Joining && rate > 0)
+                throw InputError("--rate is for --layout joining; chart layouts take --samples or --texels");
+            if (opt.layout == LayoutKind::Joining && !texels.empty())
+                throw InputError("--texels is for --layout isolated or uv");
+            if (opt.layout != LayoutKind::Joining && targetError > 0)
+                throw InputError("--target-error searches joining layouts only");
+            if (!texels.empty()) {
+                int w = 0, h = 0;
+                char x = 0, extra = 0;
+                const int got = std::sscanf(texels.c_str(), "%d%c%d%c", &w, &x, &h, &extra);
+                if (got == 1) h = w;
+                if (!((got == 1) || (got == 3 && (x == 'x' || x == 'X'))) || w < 1 || h < 1 ||
+                    w > 16384 || h > 16384)
+                    throw InputError("--texels: expected WxH or W (1 to 16384), got '" + texels + "'");
+                opt.charts.texels = {w, h};
             }
-            const ShardData shard = bakeShard(plan, slice);
+            opt.grid = parseGrid(grid, "--grid");
+            opt.trace.branch = branch == "transmit" ? Branch::Transmit : Branch::Fresnel;
+            opt.precision = parsePrecision(precision);
+            opt.fit = parseFit(fit);
+            opt.weighting = FitWeighting::parse(weighting);
+            opt.cacheDir = cache;
+            opt.coherent = tracer == "coherent";
+            ShardSlice slice;
+            if (!shardText.empty()) {
+                slice = parseShard(shardText, std::getenv("SLURM_ARRAY_TASK_ID"));
+                if (targetError > 0)
+                    throw InputError("--target-error cannot be combined with --shard: run the search "
+                                     "once, then shard with the --order, --rate and --grid it chose");
+            }
+            if (workDir.empty()) workDir = output + ".work";
+            // Every output checked and staged before the work: a bad path fails now, not after an
+            // hour of tracing, and nothing appears under its name until all are complete.
+            OutputSet outputs;
+            const std::string stagedBake = outputs.add(output);
+            const std::string stagedReport = targetReport.empty() ? "" : outputs.add(targetReport);
+
+            Medium medium;
+            medium.ior = ior;
+            Scene scene = loadScene(input, medium);
+            for (const Part& p : scene.parts)
+                for (const std::string& w : p.report.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+
+            if (targetError > 0) {
+                TargetSearchOptions topt;
+                topt.targetDeg = targetError;
+                if (!quiet) std::fprintf(stderr, "target-error: searching order, rate and grid on held-out pairs...\n");
+                TargetSearchResult t = searchTarget(scene, opt, topt);
+                const TargetCandidate& c = t.chosen;
+                const TargetCandidate& p = t.reference;
+                std::printf("target-error %.3g deg: %s order %d, rate %d, grid %s: median %.2f deg, p95 %.1f deg\n",
+                            targetError, t.reached ? "chose" : "NOT REACHED; most accurate is", c.order, c.rate,
+                            c.grid.ToString().c_str(), c.medianDeg, c.p95Deg);
+                std::printf("  paper's fixed model (order 8, rate %d, grid 32x64): median %.2f deg, %.1f MB of "
+                            "weights, %.3g paths\n", p.rate, p.medianDeg, p.weightBytes / 1e6, p.bakeCost);
+                std::printf("  chosen: %.1f MB of weights (%.2fx less), %.3g paths (%.2fx less)\n", c.weightBytes / 1e6,
+                            double(p.weightBytes) / std::max<size_t>(1, c.weightBytes), c.bakeCost,
+                            p.bakeCost / std::max(1.0, c.bakeCost));
+                if (!targetReport.empty()) writeFile(stagedReport, t.ToJson().dump(2) + "\n");
+                opt.order = c.order;
+                opt.rate = c.rate;
+                opt.grid = c.grid;
+            }
+
+            const bool tty = cli::stderrIsTerminal();
+            int lastDecile = -1;
+            if (!quiet) {
+                opt.progress = [&](const BakeProgress& p) {
+                    double f = double(p.samplesDone) / std::max<size_t>(1, p.samplesTotal);
+                    double rps = p.rays / std::max(1e-9, p.seconds);
+                    // This run's pace over the samples it has done (not the resumed ones).
+                    double g = double(p.samplesDone - p.samplesResumed) / std::max<size_t>(1, p.samplesTotal);
+                    double eta = g > 0 ? p.seconds * (1 - f) / g : 0;
+                    if (tty) {
+                        int filled = static_cast<int>(f * 30);
+                        std::fprintf(stderr, "\r[%-30s] %5.1f%%  %zu/%zu samples  %6.2f Mrays/s  ETA %s ",
+                                     std::string(filled, '#').c_str(), 100 * f, p.samplesDone,
+                                     p.samplesTotal, rps * 1e-6, cli::formatDuration(eta).c_str());
+                    } else if (int(f * 10) > lastDecile) {
+                        lastDecile = int(f * 10);
+                        std::fprintf(stderr, "bake: %3.0f%% (%zu/%zu samples, %.2f Mrays/s, ETA %s)\n", 100 * f,
+                                     p.samplesDone, p.samplesTotal, rps * 1e-6, cli::formatDuration(eta).c_str());
+                    }
+                };
+            }
+            if (opt.layout == LayoutKind::Joining && opt.rate == 0) {
+                // Say what --samples becomes: the smallest rate reaching it, usually more samples.
+                opt.rate = rateForSampleCount(scene, opt.samples);
+                const size_t n = joiningSampleCount(scene, opt.rate);
+                if (n != opt.samples)
+                    cli::note(kTool, "--samples " + std::to_string(opt.samples) + ": rate " +
+                                         std::to_string(opt.rate) + " gives " + std::to_string(n) +
+                                         " unique samples (" +
+                                         (n > opt.samples ? "the smallest rate that reaches it"
+                                                          : "the largest rate; it cannot reach it") +
+                                         ")");
+            }
+
+            auto note = [&](const std::string& text) {
+                if (!quiet) std::fprintf(stderr, "%s%s\n", tty ? "\r" : "", text.c_str());
+            };
+            BakePlan plan(scene, opt, input);
+            for (const std::string& w : plan.chartStats().warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+            if (!shardText.empty()) {
+                // One slice into a shard file, for shrefract-merge.
+                if (resume && fs::exists(output)) {
+                    try {
+                        const ShardData old = readShard(output);
+                        if (shardMismatch(old, shardIdentity(plan), slice, plan.batchCount()).empty()) {
+                            std::printf("%s: slice %d of %d is already complete\n", output.c_str(),
+                                        slice.index, slice.count);
+                            return int(cli::kOk);
+                        }
+                    } catch (const InputError& e) {
+                        note(std::string("baking it again: ") + e.what());
+                    }
+                }
+                const ShardData shard = bakeShard(plan, slice);
+                if (!quiet && tty) std::fprintf(stderr, "\n");
+                writeShard(stagedBake, shard);
+                if (opt.cancel->load()) throw Cancelled();  // a signal during the write: keep nothing
+                outputs.commit();
+                const BakeStats st = BakeStats::fromJson(shard.manifest["stats"]);
+                std::printf("baked %s slice %d of %d -> %s\n", input.c_str(), slice.index, slice.count,
+                            output.c_str());
+                std::printf("  samples     %zu of %zu (from %zu), paths %zu, rays %zu\n", shard.sampleCount,
+                            plan.sampleCount(), shard.manifest["shard"].value("first", size_t(0)), st.paths,
+                            st.rays);
+                std::printf("  time        %.1f s wall (layout %.1f s, slice %.1f s)\n",
+                            std::chrono::duration<double>(Clock::now() - start).count(), plan.setupSeconds(),
+                            st.wallSeconds);
+                return int(cli::kOk);
+            }
+            const int nCheckpoints = checkpointCount(plan, checkpoints);
+            BakeResult res;
+            if (nCheckpoints <= 1) {
+                SliceResult all = plan.bakeSlice(0, plan.batchCount());
+                res.stats = all.stats;
+                res.data = plan.data(std::move(all.weights), res.stats);
+            } else {
+                CheckpointOptions co;
+                co.workDir = workDir;
+                co.count = nCheckpoints;
+                co.resume = resume;
+                co.log = note;
+                checkpointDir = workDir;
+                res = bakeWithCheckpoints(plan, co);
+            }
+            res.stats.rhoOverhead = rhoOverhead(plan.layout());
+            res.stats.charts = plan.chartStats();
             if (!quiet && tty) std::fprintf(stderr, "\n");
-            writeShard(stagedBake, shard);
+            writeBake(stagedBake, res.data);
             if (opt.cancel->load()) throw Cancelled();  // a signal during the write: keep nothing
             outputs.commit();
-            const BakeStats st = BakeStats::fromJson(shard.manifest["stats"]);
-            std::printf("baked %s slice %d of %d -> %s\n", input.c_str(), slice.index, slice.count,
-                        output.c_str());
-            std::printf("  samples     %zu of %zu (from %zu), paths %zu, rays %zu\n", shard.sampleCount,
-                        plan.sampleCount(), shard.manifest["shard"].value("first", size_t(0)), st.paths,
-                        st.rays);
-            std::printf("  time        %.1f s wall (layout %.1f s, slice %.1f s)\n",
-                        std::chrono::duration<double>(Clock::now() - start).count(), plan.setupSeconds(),
-                        st.wallSeconds);
-            return int(cli::kOk);
-        }
-        const int nCheckpoints = checkpointCount(plan, checkpoints);
-        BakeResult res;
-        if (nCheckpoints <= 1) {
-            SliceResult all = plan.bakeSlice(0, plan.batchCount());
-            res.stats = all.stats;
-            res.data = plan.data(std::move(all.weights), res.stats);
-        } else {
-            CheckpointOptions co;
-            co.workDir = workDir;
-            co.count = nCheckpoints;
-            co.resume = resume;
-            co.log = note;
-            checkpointDir = workDir;
-            res = bakeWithCheckpoints(plan, co);
-        }
-        res.stats.rhoOverhead = rhoOverhead(plan.layout());
-        res.stats.charts = plan.chartStats();
-        if (!quiet && tty) std::fprintf(stderr, "\n");
-        writeBake(stagedBake, res.data);
-        if (opt.cancel->load()) throw Cancelled();  // a signal during the write: keep nothing
-        outputs.commit();
-        if (nCheckpoints > 1) removeCheckpoints(workDir);
-        res.stats.wallSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+            if (nCheckpoints > 1) removeCheckpoints(workDir);
+            res.stats.wallSeconds = std::chrono::duration<double>(Clock::now() - start).count();
 
-        const BakeStats& s = res.stats;
-        auto pct = [&](size_t k) { return 100.0 * double(k) / double(std::max<size_t>(1, s.paths)); };
-        const SurfaceLayout& L = res.data.layout;
-        std::printf("baked %s -> %s\n", input.c_str(), output.c_str());
-        if (L.isChartLayout()) {
-            const ChartStats& c = s.charts;
-            std::printf("  samples     %zu covered texels of a %dx%d atlas (%.2f texels/sample), %s "
-                        "layout, %d triangles\n",
-                        s.samples, L.muWidth, L.muHeight, s.rhoOverhead, ToString(L.kind), L.triangleCount);
-            std::printf("  charts      %d (%d splits, %d unfolded by ARAP), gutter %d, density spread "
-                        "%.2fx, largest conformal distortion %.2f\n",
-                        c.charts, c.splits, c.arapCharts, L.atlas.gutter, c.densitySpread,
-                        c.maxConformalDistortion);
-            std::printf("  cuts        %zu smooth seam edges, %zu crease edges, %zu border edges; "
-                        "%zu of %zu gutter texels seam-aware\n",
-                        c.seamEdges, c.creaseEdges, c.borderEdges, c.seamSources, c.gutterTexels);
-        } else {
-            std::printf("  samples     %zu (rate %d, %d triangles), mu %dx%d, rho %dx%d (%.2f texels/sample)\n",
-                        s.samples, L.rate, L.triangleCount, L.muWidth, L.muHeight, L.rhoWidth, L.rhoHeight,
-                        s.rhoOverhead);
+            const BakeStats& s = res.stats;
+            auto pct = [&](size_t k) { return 100.0 * double(k) / double(std::max<size_t>(1, s.paths)); };
+            const SurfaceLayout& L = res.data.layout;
+            std::printf("baked %s -> %s\n", input.c_str(), output.c_str());
+            if (L.isChartLayout()) {
+                const ChartStats& c = s.charts;
+                std::printf("  samples     %zu covered texels of a %dx%d atlas (%.2f texels/sample), %s "
+                            "layout, %d triangles\n",
+                            s.samples, L.muWidth, L.muHeight, s.rhoOverhead, ToString(L.kind), L.triangleCount);
+                std::printf("  charts      %d (%d splits, %d unfolded by ARAP), gutter %d, density spread "
+                            "%.2fx, largest conformal distortion %.2f\n",
+                            c.charts, c.splits, c.arapCharts, L.atlas.gutter, c.densitySpread,
+                            c.maxConformalDistortion);
+                std::printf("  cuts        %zu smooth seam edges, %zu crease edges, %zu border edges; "
+                            "%zu of %zu gutter texels seam-aware\n",
+                            c.seamEdges, c.creaseEdges, c.borderEdges, c.seamSources, c.gutterTexels);
+            } else {
+                std::printf("  samples     %zu (rate %d, %d triangles), mu %dx%d, rho %dx%d (%.2f texels/sample)\n",
+                            s.samples, L.rate, L.triangleCount, L.muWidth, L.muHeight, L.rhoWidth, L.rhoHeight,
+                            s.rhoOverhead);
+            }
+            std::printf("  paths       %zu (%d directions), rays %zu (%.2f per path)\n", s.paths,
+                        opt.grid.count(), s.rays, double(s.rays) / std::max<size_t>(1, s.paths));
+            if (nCheckpoints <= 1)
+                std::printf("  time        %.1f s wall (trace %.1f s, compress %.1f s thread time), %.2f Mrays/s\n",
+                            s.wallSeconds, s.traceSeconds, s.compressSeconds, s.rays / s.wallSeconds * 1e-6);
+            else
+                std::printf("  time        %.1f s wall, %d checkpoints (%.1f s of slices in all runs)\n",
+                            s.wallSeconds, nCheckpoints, res.data.manifest["stats"].value("seconds", 0.0));
+            std::printf("  paths with  TIR %.2f%%, capped %.3f%% (soft %.3f%%), left and re-entered %.2f%%, "
+                        "geometric-normal fallback %.3f%%, leaked %.3f%%\n",
+                        pct(s.tir), pct(s.capped), pct(s.softCapped), pct(s.reentered), pct(s.geometricNormal),
+                        pct(s.leaked));
+            std::printf("  file        %.1f MB, order %d, %d coefficients, %s\n",
+                        std::filesystem::file_size(output) / 1e6, opt.order, res.data.coefficientCount(),
+                        precision.c_str());
+            return int(cli::kOk);
+        } catch (const Cancelled&) {
+            if (!checkpointDir.empty())
+                std::fprintf(stderr, "\n%s: finished checkpoints stay in %s: run the same command with "
+                                     "--resume to continue\n", kTool, checkpointDir.c_str());
+            throw;
         }
-        std::printf("  paths       %zu (%d directions), rays %zu (%.2f per path)\n", s.paths,
-                    opt.grid.count(), s.rays, double(s.rays) / std::max<size_t>(1, s.paths));
-        if (nCheckpoints <= 1)
-            std::printf("  time        %.1f s wall (trace %.1f s, compress %.1f s thread time), %.2f Mrays/s\n",
-                        s.wallSeconds, s.traceSeconds, s.compressSeconds, s.rays / s.wallSeconds * 1e-6);
-        else
-            std::printf("  time        %.1f s wall, %d checkpoints (%.1f s of slices in all runs)\n",
-                        s.wallSeconds, nCheckpoints, res.data.manifest["stats"].value("seconds", 0.0));
-        std::printf("  paths with  TIR %.2f%%, capped %.3f%% (soft %.3f%%), left and re-entered %.2f%%, "
-                    "geometric-normal fallback %.3f%%, leaked %.3f%%\n",
-                    pct(s.tir), pct(s.capped), pct(s.softCapped), pct(s.reentered), pct(s.geometricNormal),
-                    pct(s.leaked));
-        std::printf("  file        %.1f MB, order %d, %d coefficients, %s\n",
-                    std::filesystem::file_size(output) / 1e6, opt.order, res.data.coefficientCount(),
-                    precision.c_str());
-        return int(cli::kOk);
-      } catch (const Cancelled&) {
-        if (!checkpointDir.empty())
-            std::fprintf(stderr, "\n%s: finished checkpoints stay in %s: run the same command with "
-                                 "--resume to continue\n", kTool, checkpointDir.c_str());
-        throw;
-      }
     });
 }

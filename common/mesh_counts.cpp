@@ -195,7 +195,13 @@ void checkPly(const std::string& path, const std::string& whole) {
     const std::string text = first == std::string::npos ? std::string() : whole.substr(first);
     std::istringstream in(text);
     std::string line;
-    if (!std::getline(in, line) || line.compare(0, 3, "ply") != 0) return;
+    // The magic in any case: OpenMesh takes "PLY" too (found by the fuzzer: an upper-case
+    // magic slipped a damaged header past this check, and OpenMesh looped on it).
+    auto isMagic = [](const std::string& l) {
+        return l.size() >= 3 && std::tolower((unsigned char)l[0]) == 'p' &&
+               std::tolower((unsigned char)l[1]) == 'l' && std::tolower((unsigned char)l[2]) == 'y';
+    };
+    if (!std::getline(in, line) || !isMagic(line)) return;
     std::string format;
     std::vector<PlyElement> elements;
     bool ended = false;

@@ -2,9 +2,11 @@
 
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <stdexcept>
 
 #include <ImfOutputFile.h>
@@ -51,10 +53,27 @@ glm::mat4 projectionMatrix(const Camera& camera, int width, int height) {
 
 namespace {
 
+using DrawObject = std::function<void(const glm::mat4& view, const glm::mat4& projection)>;
+
+// One frame of each kind of method, between binding a target and reading or finishing it.
+DrawObject drawing(Refractor& refractor, const Environment& environment, const Camera& camera) {
+    return [&refractor, &environment, eye = camera.eye](const glm::mat4& view, const glm::mat4& projection) {
+        const glm::mat4 model(1.0f);
+        refractor.update(eye, model);
+        environment.drawBackground(view, projection);
+        refractor.draw(view, projection, model, environment);
+    };
+}
+DrawObject drawing(Baseline& baseline, const Environment& environment) {
+    return [&baseline, &environment](const glm::mat4& view, const glm::mat4& projection) {
+        environment.drawBackground(view, projection);
+        baseline.draw(view, projection, glm::mat4(1.0f), environment);
+    };
+}
+
 // Offscreen colour + direction targets (OffscreenTarget), then `drawObject(view, projection)`,
 // read back.
-RenderedFrame renderWith(const std::function<void(const glm::mat4&, const glm::mat4&)>& drawObject,
-                         const Camera& camera, int width, int height) {
+RenderedFrame renderWith(const DrawObject& drawObject, const Camera& camera, int width, int height) {
     ensureLoaded(currentContextLoader());
     OffscreenTarget target(width, height);
     target.bind();
@@ -64,31 +83,50 @@ RenderedFrame renderWith(const std::function<void(const glm::mat4&, const glm::m
     return out;
 }
 
+double timeWith(const DrawObject& drawObject, const Camera& camera, int width, int height, int frames) {
+    if (frames < 1) throw std::invalid_argument("shrefract: frameWallMs needs at least one frame");
+    ensureLoaded(currentContextLoader());
+    OffscreenTarget target(width, height);
+    const glm::mat4 view = viewMatrix(camera), projection = projectionMatrix(camera, width, height);
+    using Clock = std::chrono::steady_clock;
+    auto frame = [&] {
+        const auto t0 = Clock::now();
+        target.bind();
+        drawObject(view, projection);
+        glFinish();
+        return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    };
+    const auto warm = Clock::now();
+    for (int k = 0; k < 2 || Clock::now() - warm < std::chrono::milliseconds(500); ++k) frame();
+    std::vector<double> ms;
+    for (int k = 0; k < frames; ++k) ms.push_back(frame());
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    std::nth_element(ms.begin(), ms.begin() + ms.size() / 2, ms.end());
+    return ms[ms.size() / 2];
+}
+
 }  // namespace
 
 RenderedFrame renderFrame(Refractor& refractor, const Environment& environment,
                           const Camera& camera, int width, int height) {
-    const glm::mat4 model(1.0f);
-    RenderedFrame out = renderWith(
-        [&](const glm::mat4& view, const glm::mat4& projection) {
-            refractor.update(camera.eye, model);
-            environment.drawBackground(view, projection);
-            refractor.draw(view, projection, model, environment);
-        },
-        camera, width, height);
+    RenderedFrame out = renderWith(drawing(refractor, environment, camera), camera, width, height);
     out.timings = refractor.timings();
     return out;
 }
 
 RenderedFrame renderFrame(Baseline& baseline, const Environment& environment,
                           const Camera& camera, int width, int height) {
-    const glm::mat4 model(1.0f);
-    return renderWith(
-        [&](const glm::mat4& view, const glm::mat4& projection) {
-            environment.drawBackground(view, projection);
-            baseline.draw(view, projection, model, environment);
-        },
-        camera, width, height);
+    return renderWith(drawing(baseline, environment), camera, width, height);
+}
+
+double frameWallMs(Refractor& refractor, const Environment& environment, const Camera& camera,
+                   int width, int height, int frames) {
+    return timeWith(drawing(refractor, environment, camera), camera, width, height, frames);
+}
+
+double frameWallMs(Baseline& baseline, const Environment& environment, const Camera& camera,
+                   int width, int height, int frames) {
+    return timeWith(drawing(baseline, environment), camera, width, height, frames);
 }
 
 OffscreenTarget::OffscreenTarget(int width, int height) : width_(width), height_(height) {

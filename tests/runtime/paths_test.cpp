@@ -120,6 +120,24 @@ TEST_P(Paths, DirectAndRhoGiveTheSameExitDirections) {
     }
 }
 
+// frameWallMs draws the frames it times into a target of its own: the frames an app renders
+// before and after it are bit-identical, it returns a time (a positive, finite median), and it
+// refuses to time no frame at all.
+TEST_P(Paths, FrameTimingLeavesTheFramesAsTheyWere) {
+    Environment env = Environment::fromLatLong(64, 32, sky(64, 32));
+    Bake bake = makeBake(test::randomBake(4, 1));
+    const Camera cam = Camera::orbit(30, 20, 3.5f);
+    auto r = make(bake, "direct");
+    const RenderedFrame before = renderFrame(*r, env, cam, 96, 96);
+    const double ms = frameWallMs(*r, env, Camera::orbit(120, -20, 3.0f), 64, 64, 3);
+    EXPECT_GT(ms, 0.0);
+    EXPECT_TRUE(std::isfinite(ms));
+    const RenderedFrame after = renderFrame(*r, env, cam, 96, 96);
+    EXPECT_EQ(before.directions, after.directions);
+    EXPECT_EQ(before.color, after.color);
+    EXPECT_THROW(frameWallMs(*r, env, cam, 64, 64, 0), std::invalid_argument);
+}
+
 // 8-bit bakes upload their codes as RGBA8 UNORM (4 bytes a texel a coefficient, against 16 for
 // float32) and the shader applies the per-coefficient scale and offset: D matches the CPU sum of
 // the dequantized weights to float rounding (measured 2.4e-7; limit 1e-4), both ways

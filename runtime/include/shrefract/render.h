@@ -60,6 +60,16 @@ RenderedFrame renderFrame(Refractor& refractor, const Environment& environment, 
 // baseline.timings().
 RenderedFrame renderFrame(Baseline& baseline, const Environment& environment, const Camera& camera,
                           int width, int height);
+// Wall-clock milliseconds per frame as an app sees it: `camera`'s frame drawn into an offscreen
+// target (update, environment background, object) and waited for with glFinish, nothing read
+// back. First a warm-up of at least two frames and half a second (llvmpipe compiles shaders at the
+// first draw; a GPU that idled comes up to clock), then the median of `frames` frames. GL timer
+// queries are no substitute on llvmpipe: they miss most of its rasterizer's work
+// (docs/runtime.md, "Benchmark").
+double frameWallMs(Refractor& refractor, const Environment& environment, const Camera& camera,
+                   int width, int height, int frames);
+double frameWallMs(Baseline& baseline, const Environment& environment, const Camera& camera,
+                   int width, int height, int frames);
 // The view and projection matrices renderFrame uses (glm::lookAt, glm::perspective, near 0.01,
 // far 1000): the reference renderer's camera must match them (docs/evaluation.md).
 glm::mat4 viewMatrix(const Camera& camera);

@@ -13,6 +13,7 @@
 #include "eval/reference.h"
 #include "common/latlong.h"
 #include "common/scene.h"
+#include "headless_test.h"
 #include "shrefract/baselines.h"
 #include "shrefract/context.h"
 #include "shrefract/render.h"
@@ -60,15 +61,8 @@ EvalBuffer reference(const Baked& b, const Camera& c) {
     return renderReference(*b.tracer, environment(), v);
 }
 
-class EndToEnd : public ::testing::TestWithParam<Backend> {
+class EndToEnd : public test::HeadlessTest {
 protected:
-    void SetUp() override {
-        try {
-            context_ = createHeadlessContext(GetParam(), kSize, kSize);
-        } catch (const ContextError& e) {
-            GTEST_SKIP() << "no " << ToString(GetParam()) << " context: " << e.what();
-        }
-    }
     EvalBuffer renderSh(const Baked& b, const Environment& env, const Camera& c,
                         const std::string& path = "auto", const std::string& shading = "spread") {
         RefractorOptions o;
@@ -88,7 +82,6 @@ protected:
         RenderedFrame f = renderFrame(*baseline, env, c, kSize, kSize);
         return makeEvalBuffer(kSize, kSize, f.color, f.directions);
     }
-    std::unique_ptr<HeadlessContext> context_;
 };
 
 double stat(const nlohmann::json& r, const char* key) { return r["angleDeg"][key].get<double>(); }

@@ -12,6 +12,7 @@
 #include "common/latlong.h"
 #include "common/prefilter.h"
 #include "common/sh.h"
+#include "headless_test.h"
 #include "shrefract/context.h"
 #include "shrefract/render.h"
 #include "shrefract/runtime.h"
@@ -34,15 +35,8 @@ std::vector<float> sky(int w, int h) {
     return rgb;
 }
 
-class Paths : public ::testing::TestWithParam<Backend> {
+class Paths : public test::HeadlessTest {
 protected:
-    void SetUp() override {
-        try {
-            context_ = createHeadlessContext(GetParam(), 96, 96);
-        } catch (const ContextError& e) {
-            GTEST_SKIP() << "no " << ToString(GetParam()) << " context: " << e.what();
-        }
-    }
     std::unique_ptr<Refractor> make(const Bake& bake, const std::string& path,
                                     const std::string& decompression = "auto",
                                     const std::string& shading = "sharp") {
@@ -53,7 +47,6 @@ protected:
         o.loader = context_->loader();
         return Refractor::create(bake, o);
     }
-    std::unique_ptr<HeadlessContext> context_;
 };
 
 // Largest angle (degrees) between two frames' exit directions over the pixels both cover, and

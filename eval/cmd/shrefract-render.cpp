@@ -52,8 +52,9 @@ std::vector<float> parseFloats(const std::string& text, size_t count, const std:
 
 // One method, set up once: renders a camera's frame and says how long it took.
 struct Method {
-    // Draws and reads back one frame; `ms`: the reference's CPU wall time, a GL method's GPU
-    // stage sum (timer queries: llvmpipe's miss most of its rasterizer's work).
+    // Draws and reads back one frame; the reference sets `ms` to its CPU wall time (a GL method's
+    // time is wallMs: its timer queries are printed per stage, but llvmpipe's miss most of its
+    // rasterizer's work).
     std::function<RenderedFrame(const Camera&, double* ms)> render;
     // A GL method's ms per frame as an app sees it (frameWallMs); empty for the reference.
     std::function<double(const Camera&)> wallMs;
@@ -364,11 +365,8 @@ int main(int argc, char** argv) {
                                     st["count"].get<size_t>(), st["median"].get<double>(),
                                     st["p95"].get<double>());
                 }
-                m.render = [&](const Camera& c, double* ms) {
-                    RenderedFrame f = renderFrame(*refractor, *env, c, width, height);
-                    const Timings& t = f.timings;
-                    *ms = t.view + t.decompress + t.smooth + t.unpack + t.shade;
-                    return f;
+                m.render = [&](const Camera& c, double*) {
+                    return renderFrame(*refractor, *env, c, width, height);
                 };
                 m.wallMs = [&](const Camera& c) {
                     return frameWallMs(*refractor, *env, c, width, height, std::max(1, frames));
@@ -381,10 +379,8 @@ int main(int argc, char** argv) {
                 std::vector<float> normalDistance;
                 if (tracer) normalDistance = normalDistances(*tracer, bake.data().layout);
                 baseline = Baseline::create(bake, normalDistance, options);
-                m.render = [&](const Camera& c, double* ms) {
-                    RenderedFrame f = renderFrame(*baseline, *env, c, width, height);
-                    *ms = baseline->timings().backFaces + baseline->timings().shade;
-                    return f;
+                m.render = [&](const Camera& c, double*) {
+                    return renderFrame(*baseline, *env, c, width, height);
                 };
                 m.wallMs = [&](const Camera& c) {
                     return frameWallMs(*baseline, *env, c, width, height, std::max(1, frames));

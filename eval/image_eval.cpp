@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "eval/directions.h"
+#include "eval/flip.h"
 #include "common/error.h"
 #include "common/png.h"
 #include "common/tonemap.h"
@@ -20,6 +21,15 @@ glm::vec3 toneMappedPixel(const EvalBuffer& b, size_t i, float exposure) {
     return toneMapAces(glm::vec3(b.color[i]), exposure);
 }
 
+// The tone-mapped image. toneMapAces ends with the sRGB transfer function (common/tonemap.h), so
+// these are display-encoded values in [0, 1]: what LDR-FLIP takes, and flipMap gets them as they
+// are (it decodes sRGB itself).
+std::vector<glm::vec3> toneMappedColors(const EvalBuffer& b, float exposure) {
+    std::vector<glm::vec3> c(b.pixelCount());
+    for (size_t i = 0; i < c.size(); ++i) c[i] = toneMappedPixel(b, i, exposure);
+    return c;
+}
+
 float luminance(glm::vec3 c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
 
 void checkSameSize(const EvalBuffer& a, const EvalBuffer& b) {
@@ -27,6 +37,124 @@ void checkSameSize(const EvalBuffer& a, const EvalBuffer& b) {
         throw InputError("image sizes differ: " + std::to_string(a.width) + "x" +
                          std::to_string(a.height) + " vs " + std::to_string(b.width) + "x" +
                          std::to_string(b.height));
+}
+
+// The SSIM map over the windows that lie inside the image ('valid'): value (x, y) belongs to the
+// window centred on pixel (x + kSsimRadius, y + kSsimRadius). Empty when the image is smaller
+// than a window.
+constexpr int kSsimRadius = 5;
+struct SsimMap {
+    std::vector<double> values;
+    int width = 0, height = 0;
+};
+
+SsimMap ssimMap(const std::vector<float>& a, const std::vector<float>& b, int w, int h) {
+    // Gaussian window 11x11, sigma 1.5, normalized (Wang et al. 2004), separable.
+    constexpr int R = kSsimRadius;
+    float g[2 * R + 1], sum = 0;
+    for (int k = -R; k <= R; ++k) sum += g[k + R] = std::exp(-(k * k) / (2.0f * 1.5f * 1.5f));
+    for (float& x : g) x /= sum;
+    const double C1 = 0.01 * 0.01, C2 = 0.03 * 0.03;  // (K L)^2 with L = 1
+    const size_t n = static_cast<size_t>(w) * h;
+    // Five blurred images: mu_a, mu_b, E[a^2], E[b^2], E[ab]; rows first, then columns, over
+    // the windows that lie inside the image ('valid').
+    SsimMap m;
+    if (w < 2 * R + 1 || h < 2 * R + 1) return m;
+    std::vector<float> src[5];
+    for (auto& s : src) s.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+        src[0][i] = a[i], src[1][i] = b[i];
+        src[2][i] = a[i] * a[i], src[3][i] = b[i] * b[i], src[4][i] = a[i] * b[i];
+    }
+    const int vw = w - 2 * R, vh = h - 2 * R;
+    std::vector<double> blur[5];
+    for (int k = 0; k < 5; ++k) {
+        std::vector<double> rows(static_cast<size_t>(vw) * h);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < vw; ++x) {
+                double s = 0;
+                for (int j = 0; j <= 2 * R; ++j) s += g[j] * src[k][static_cast<size_t>(y) * w + x + j];
+                rows[static_cast<size_t>(y) * vw + x] = s;
+            }
+        blur[k].resize(static_cast<size_t>(vw) * vh);
+        for (int y = 0; y < vh; ++y)
+            for (int x = 0; x < vw; ++x) {
+                double s = 0;
+                for (int j = 0; j <= 2 * R; ++j) s += g[j] * rows[static_cast<size_t>(y + j) * vw + x];
+                blur[k][static_cast<size_t>(y) * vw + x] = s;
+            }
+    }
+    m.width = vw, m.height = vh;
+    m.values.resize(blur[0].size());
+    for (size_t i = 0; i < blur[0].size(); ++i) {
+        double ma = blur[0][i], mb = blur[1][i];
+        double va = blur[2][i] - ma * ma, vb = blur[3][i] - mb * mb, cov = blur[4][i] - ma * mb;
+        m.values[i] = ((2 * ma * mb + C1) * (2 * cov + C2)) / ((ma * ma + mb * mb + C1) * (va + vb + C2));
+    }
+    return m;
+}
+
+// Mean of the SSIM map over the windows whose centre pixel (an index into the w-wide image)
+// `keep` accepts; NaN when there are none.
+template <class Keep>
+double ssimMean(const SsimMap& m, int w, Keep keep) {
+    double total = 0;
+    size_t count = 0;
+    for (int y = 0; y < m.height; ++y)
+        for (int x = 0; x < m.width; ++x)
+            if (keep(static_cast<size_t>(y + kSsimRadius) * w + x + kSsimRadius)) {
+                total += m.values[static_cast<size_t>(y) * m.width + x];
+                ++count;
+            }
+    return count ? total / count : std::nan("");
+}
+
+// The whole image's mean; 1 for an image smaller than a window (no structure to compare).
+double wholeSsim(const SsimMap& m, int w) {
+    const double s = ssimMean(m, w, [](size_t) { return true; });
+    return std::isnan(s) ? 1.0 : s;
+}
+
+// |L - G * L| per pixel, G a Gaussian of sigma 2 px (radius 6, separable, clamp to edge): the
+// detail a blur of that width removes, a band-pass of the luminance.
+std::vector<float> bandPassDetail(const std::vector<float>& l, int w, int h) {
+    constexpr int R = 6;
+    float g[2 * R + 1], sum = 0;
+    for (int k = -R; k <= R; ++k) sum += g[k + R] = std::exp(-(k * k) / (2.0f * 2.0f * 2.0f));
+    for (float& x : g) x /= sum;
+    std::vector<float> rows(l.size()), out(l.size());
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            float s = 0;
+            for (int j = -R; j <= R; ++j) s += g[j + R] * l[static_cast<size_t>(y) * w + std::clamp(x + j, 0, w - 1)];
+            rows[static_cast<size_t>(y) * w + x] = s;
+        }
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            float s = 0;
+            for (int j = -R; j <= R; ++j) s += g[j + R] * rows[static_cast<size_t>(std::clamp(y + j, 0, h - 1)) * w + x];
+            const size_t i = static_cast<size_t>(y) * w + x;
+            out[i] = std::abs(l[i] - s);
+        }
+    return out;
+}
+
+// A JSON number, or null where the quantity is undefined (NaN).
+nlohmann::json numberOrNull(double v) { return std::isnan(v) ? nlohmann::json(nullptr) : nlohmann::json(v); }
+
+// The legend strip under a heat map: the ramp across the width from 0 to maxValue, labelled "0"
+// and `right`.
+void drawLegend(Image8& img, int top, float maxValue, const std::string& right) {
+    const int x0 = 4, x1 = std::max(x0 + 1, img.width - 4);
+    for (int x = x0; x < x1; ++x) {
+        glm::u8vec3 c = errorColor(maxValue * (x - x0) / float(x1 - x0 - 1), maxValue);
+        for (int y = top + 2; y < top + 10; ++y) {
+            uint8_t* p = img.at(x, y);
+            p[0] = c.r, p[1] = c.g, p[2] = c.b;
+        }
+    }
+    drawText(img, x0, top + 13, "0", {255, 255, 255}, 1);
+    drawText(img, x1 - 6 * static_cast<int>(right.size()), top + 13, right, {255, 255, 255}, 1);
 }
 
 // 5x7 bitmap glyphs, row by row, '#' set. Upper case, digits and a little punctuation.
@@ -85,64 +213,26 @@ std::vector<float> angularErrors(const EvalBuffer& ref, const EvalBuffer& test) 
 }
 
 double ssim(const std::vector<float>& a, const std::vector<float>& b, int w, int h) {
-    // Gaussian window 11x11, sigma 1.5, normalized (Wang et al. 2004), separable.
-    constexpr int R = 5;
-    float g[2 * R + 1], sum = 0;
-    for (int k = -R; k <= R; ++k) sum += g[k + R] = std::exp(-(k * k) / (2.0f * 1.5f * 1.5f));
-    for (float& x : g) x /= sum;
-    const double C1 = 0.01 * 0.01, C2 = 0.03 * 0.03;  // (K L)^2 with L = 1
-    const size_t n = static_cast<size_t>(w) * h;
-    // Five blurred images: mu_a, mu_b, E[a^2], E[b^2], E[ab]; rows first, then columns, over
-    // the windows that lie inside the image ('valid').
-    if (w < 2 * R + 1 || h < 2 * R + 1) return 1.0;
-    std::vector<float> src[5];
-    for (auto& s : src) s.resize(n);
-    for (size_t i = 0; i < n; ++i) {
-        src[0][i] = a[i], src[1][i] = b[i];
-        src[2][i] = a[i] * a[i], src[3][i] = b[i] * b[i], src[4][i] = a[i] * b[i];
-    }
-    const int vw = w - 2 * R, vh = h - 2 * R;
-    std::vector<double> blur[5];
-    for (int k = 0; k < 5; ++k) {
-        std::vector<double> rows(static_cast<size_t>(vw) * h);
-        for (int y = 0; y < h; ++y)
-            for (int x = 0; x < vw; ++x) {
-                double s = 0;
-                for (int j = 0; j <= 2 * R; ++j) s += g[j] * src[k][static_cast<size_t>(y) * w + x + j];
-                rows[static_cast<size_t>(y) * vw + x] = s;
-            }
-        blur[k].resize(static_cast<size_t>(vw) * vh);
-        for (int y = 0; y < vh; ++y)
-            for (int x = 0; x < vw; ++x) {
-                double s = 0;
-                for (int j = 0; j <= 2 * R; ++j) s += g[j] * rows[static_cast<size_t>(y + j) * vw + x];
-                blur[k][static_cast<size_t>(y) * vw + x] = s;
-            }
-    }
-    double total = 0;
-    for (size_t i = 0; i < blur[0].size(); ++i) {
-        double ma = blur[0][i], mb = blur[1][i];
-        double va = blur[2][i] - ma * ma, vb = blur[3][i] - mb * mb, cov = blur[4][i] - ma * mb;
-        total += ((2 * ma * mb + C1) * (2 * cov + C2)) / ((ma * ma + mb * mb + C1) * (va + vb + C2));
-    }
-    return total / blur[0].size();
+    return wholeSsim(ssimMap(a, b, w, h), w);
 }
 
 nlohmann::json compareImages(const EvalBuffer& ref, const EvalBuffer& test, float exposure) {
     checkSameSize(ref, test);
+    const int w = ref.width, h = ref.height;
     const std::vector<float> e = angularErrors(ref, test);
+    const std::vector<glm::vec3> cRef = toneMappedColors(ref, exposure), cTest = toneMappedColors(test, exposure);
     std::vector<double> angles;
     size_t cr = 0, ct = 0, both = 0, refOnly = 0, testOnly = 0;
-    double se = 0;
+    double se = 0, seObject = 0;
     std::vector<float> la(ref.pixelCount()), lb(ref.pixelCount());
     for (size_t i = 0; i < e.size(); ++i) {
         const bool a = ref.covered(i), b = test.covered(i);
         cr += a, ct += b, both += a && b, refOnly += a && !b, testOnly += b && !a;
         if (e[i] >= 0) angles.push_back(e[i]);
-        glm::vec3 x = toneMappedPixel(ref, i, exposure), y = toneMappedPixel(test, i, exposure);
-        glm::vec3 d = x - y;
+        const glm::vec3 d = cRef[i] - cTest[i];
         se += glm::dot(d, d);
-        la[i] = luminance(x), lb[i] = luminance(y);
+        if (a) seObject += glm::dot(d, d);
+        la[i] = luminance(cRef[i]), lb[i] = luminance(cTest[i]);
     }
     const double mse = se / (3.0 * std::max<size_t>(1, e.size()));
     const double psnr = mse > 0 ? 10.0 * std::log10(1.0 / mse) : 99.0;  // 99: identical
@@ -160,13 +250,26 @@ nlohmann::json compareImages(const EvalBuffer& ref, const EvalBuffer& test, floa
                     const int xx = std::clamp(x + dx, 0, ref.width - 1), yy = std::clamp(y + dy, 0, ref.height - 1);
                     if (ref.covered(static_cast<size_t>(yy) * ref.width + xx) != ref.covered(i)) edge = true;
                 }
-            const glm::vec3 d = toneMappedPixel(ref, i, exposure) - toneMappedPixel(test, i, exposure);
+            const glm::vec3 d = cRef[i] - cTest[i];
             const int cls = edge ? 0 : ref.covered(i) ? 1 : 2;
             seClass[cls] += glm::dot(d, d);
             nInterior += cls == 1;
         }
     const double seAll = std::max(1e-30, seClass[0] + seClass[1] + seClass[2]);
     const double mseInterior = seClass[1] / (3.0 * std::max<size_t>(1, nInterior));
+    // What a viewer sees on the object (the pixels the reference covers), the silhouette included:
+    // PSNR, SSIM, the detail kept and FLIP; undefined (null) without object pixels.
+    const auto object = [&](size_t i) { return ref.covered(i); };
+    const SsimMap ssims = ssimMap(la, lb, w, h);
+    const std::vector<float> detailRef = bandPassDetail(la, w, h), detailTest = bandPassDetail(lb, w, h);
+    const std::vector<float> flip = flipMap(cRef, cTest, w, h);
+    double sumDetailRef = 0, sumDetailTest = 0, sumFlip = 0, sumFlipObject = 0;
+    for (size_t i = 0; i < flip.size(); ++i) {
+        sumFlip += flip[i];
+        if (!object(i)) continue;
+        sumDetailRef += detailRef[i], sumDetailTest += detailTest[i], sumFlipObject += flip[i];
+    }
+    const double nan = std::nan(""), mseObject = seObject / (3.0 * std::max<size_t>(1, cr));
     return {{"width", ref.width},
             {"height", ref.height},
             {"angleDeg", errorStats(angles)},
@@ -178,7 +281,12 @@ nlohmann::json compareImages(const EvalBuffer& ref, const EvalBuffer& test, floa
             {"errorShare",
              {{"silhouette", seClass[0] / seAll}, {"interior", seClass[1] / seAll},
               {"background", seClass[2] / seAll}}},
-            {"ssim", ssim(la, lb, ref.width, ref.height)}};
+            {"ssim", wholeSsim(ssims, w)},
+            {"objectPsnr", numberOrNull(cr == 0 ? nan : mseObject > 0 ? 10.0 * std::log10(1.0 / mseObject) : 99.0)},
+            {"objectSsim", numberOrNull(ssimMean(ssims, w, object))},
+            {"detailRatio", numberOrNull(sumDetailRef > 0 ? sumDetailTest / sumDetailRef : nan)},
+            {"objectFlip", numberOrNull(cr == 0 ? nan : sumFlipObject / cr)},
+            {"flip", sumFlip / std::max<size_t>(1, flip.size())}};
 }
 
 glm::u8vec3 errorColor(float degrees, float maxDegrees) {
@@ -215,20 +323,24 @@ Image8 heatMap(const EvalBuffer& ref, const EvalBuffer& test, float maxDegrees, 
             else c = glm::u8vec3(glm::round(toneMappedPixel(ref, i, exposure) * 255.0f * 0.25f));
             p[0] = c.r, p[1] = c.g, p[2] = c.b;
         }
-    // Legend: the ramp across the width, labelled at both ends.
-    const int x0 = 4, x1 = std::max(x0 + 1, ref.width - 4);
-    for (int x = x0; x < x1; ++x) {
-        glm::u8vec3 c = errorColor(maxDegrees * (x - x0) / float(x1 - x0 - 1), maxDegrees);
-        for (int y = ref.height + 2; y < ref.height + 10; ++y) {
-            uint8_t* p = img.at(x, y);
-            p[0] = c.r, p[1] = c.g, p[2] = c.b;
-        }
-    }
     char right[32];
     std::snprintf(right, sizeof right, "%g DEG", maxDegrees);
-    drawText(img, x0, ref.height + 13, "0", {255, 255, 255}, 1);
-    drawText(img, x1 - 6 * static_cast<int>(std::string(right).size()), ref.height + 13, right,
-             {255, 255, 255}, 1);
+    drawLegend(img, ref.height, maxDegrees, right);
+    return img;
+}
+
+Image8 flipHeatMap(const EvalBuffer& ref, const EvalBuffer& test, float exposure) {
+    checkSameSize(ref, test);
+    const std::vector<float> flip =
+        flipMap(toneMappedColors(ref, exposure), toneMappedColors(test, exposure), ref.width, ref.height);
+    const int legend = 24;
+    Image8 img;
+    img.resize(ref.width, ref.height + legend);
+    for (size_t i = 0; i < flip.size(); ++i) {
+        const glm::u8vec3 c = errorColor(flip[i], 1.0f);
+        img.rgb[3 * i] = c.r, img.rgb[3 * i + 1] = c.g, img.rgb[3 * i + 2] = c.b;
+    }
+    drawLegend(img, ref.height, 1.0f, "1 FLIP");
     return img;
 }
 

@@ -1,5 +1,6 @@
-// Comparing rendered evaluation buffers (common/evalbuffer.h): direction error, coverage, PSNR and
-// SSIM of the tone-mapped images, error heat maps and labelled montages (docs/evaluation.md).
+// Comparing rendered evaluation buffers (common/evalbuffer.h): direction error, coverage, PSNR,
+// SSIM and FLIP of the tone-mapped images, error heat maps and labelled montages
+// (docs/evaluation.md).
 // Needs no Embree; it lives in bake/ beside the other evaluation code.
 #pragma once
 
@@ -35,7 +36,13 @@ std::vector<float> angularErrors(const EvalBuffer& ref, const EvalBuffer& test);
 // errorShare {silhouette, interior, background}: where the squared error lies (silhouette: the
 // reference's coverage changes within the 3 x 3 neighbourhood); ssim: mean SSIM of the tone-mapped
 // luminance (Rec. 709 weights), 11x11 Gaussian window sigma 1.5, K1 0.01, K2 0.03, L 1, over
-// the windows that lie inside the image. Throws InputError if the sizes differ.
+// the windows that lie inside the image. Object metrics, over the pixels the reference covers (the
+// object mask), null when it covers none: objectPsnr as psnr; objectSsim, the mean of the same
+// SSIM map over the windows centred on object pixels; detailRatio, the mean of |L - G2 * L| (L the
+// tone-mapped luminance, G2 a Gaussian of sigma 2 px) of the test over the reference's (1: detail
+// kept, < 1 blurred, > 1 noisier; null when the reference has none); objectFlip, the mean LDR-FLIP
+// (eval/flip.h) of the tone-mapped images; and flip, its mean over all pixels. Throws InputError
+// if the sizes differ.
 nlohmann::json compareImages(const EvalBuffer& ref, const EvalBuffer& test, float exposure = 1.0f);
 
 // Mean SSIM of two single-channel images in [0, 1] (the definition above); exposed for tests.
@@ -50,6 +57,10 @@ glm::u8vec3 errorColor(float degrees, float maxDegrees);
 // legend strip under the image (ramp, "0" ... "30 DEG").
 Image8 heatMap(const EvalBuffer& ref, const EvalBuffer& test, float maxDegrees = 30.0f,
                float exposure = 1.0f);
+
+// FLIP heat map: every pixel's LDR-FLIP of the tone-mapped images through errorColor(flip, 1), and
+// a legend strip under the image ("0" ... "1 FLIP").
+Image8 flipHeatMap(const EvalBuffer& ref, const EvalBuffer& test, float exposure = 1.0f);
 
 // The tone-mapped colour of a buffer.
 Image8 toneMapped(const EvalBuffer& buffer, float exposure = 1.0f);

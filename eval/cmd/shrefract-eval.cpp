@@ -1,8 +1,9 @@
 // shrefract-eval: how close a bake comes to the truth.
 //   directions BAKE --pairs N --seed S --json REPORT.json   decompressed vs freshly traced
 //   query BAKE --in Q.csv --out A.csv                        exit direction per (point, view)
-//   image --ref A.exr --test B.exr [--heatmap H.png] [--json R.json]   two evaluation buffers
-//   montage --out M.png IMG.exr... [--labels L...] [--errors]        labelled side by side
+//   image --ref A.exr --test B.exr [--heatmap H.png] [--flip-map F.png] [--json R.json]
+//                                                            two evaluation buffers
+//   montage --out M.png IMG.exr... [--labels L...] [--errors] [--flip]   labelled side by side
 //   compose R.exr G.exr B.exr --out D.exr    colour channel c of input c (dispersion)
 #include <CLI/CLI.hpp>
 
@@ -54,6 +55,18 @@ void printTable(const nlohmann::json& r) {
     row("TIR", r["tir"]);
     row("re-entered", r["reentered"]);
     row("capped", r["capped"]);
+    if (!r.contains("prediction")) return;
+    const nlohmann::json& p = r["prediction"];
+    std::printf("error prediction, Spearman with the measured angle: 1 - |D| %.3f", p["spearmanShortness"].get<double>());
+    if (!p.contains("spearman")) {
+        std::printf(" (the bake has no error model)\n");
+        return;
+    }
+    std::printf(", error model %.3f\n  deciles of the prediction, median degrees predicted / measured:\n ",
+                p["spearman"].get<double>());
+    for (const auto& b : p["deciles"])
+        std::printf(" %.2f/%.2f", b["predictedDeg"].get<double>(), b["measuredDeg"].get<double>());
+    std::printf("\n");
 }
 
 // "0.5,1,2" -> numbers, each finite and > 0.
@@ -106,22 +119,24 @@ int main(int argc, char** argv) {
     query->add_option("--max-distance", maxDistance,
                       "refuse points farther than this from the surface, object units (default: "
                       "0.001 of the bake's bounding-box diagonal)");
-    std::string refPath, testPath, heatPath, outPng;
+    std::string refPath, testPath, heatPath, flipPath, outPng;
     float maxDeg = 30.0f, exposure = 1.0f;
     auto* image = app.add_subcommand("image", "compare two render evaluation buffers (docs/evaluation.md)");
     image->add_option("--ref", refPath, "reference evaluation buffer EXR (shrefract-render --dirs)")->required();
     image->add_option("--test", testPath, "tested evaluation buffer EXR")->required();
     image->add_option("--heatmap", heatPath, "angular error heat map PNG");
+    image->add_option("--flip-map", flipPath, "LDR-FLIP heat map PNG of the tone-mapped images (0 ... 1)");
     image->add_option("--max-deg", maxDeg, "heat map: degrees at the top of the ramp")->capture_default_str();
     image->add_option("--exposure", exposure, "exposure before the tone map")->capture_default_str();
     image->add_option("--json", jsonPath, "write the report here");
     std::vector<std::string> inputs, labels;
-    bool withErrors = false;
+    bool withErrors = false, withFlip = false;
     auto* mont = app.add_subcommand("montage", "labelled side-by-side PNG of evaluation buffers (paper Figure 11)");
     mont->add_option("inputs", inputs, "evaluation buffer EXRs, the reference first")->required();
     mont->add_option("--labels", labels, "one label per input (default: file names)");
     mont->add_option("--out", outPng, "montage PNG")->required();
     mont->add_flag("--errors", withErrors, "a second row: angular error heat maps against the first input");
+    mont->add_flag("--flip", withFlip, "a further row: LDR-FLIP maps against the first input, object FLIP beneath");
     mont->add_option("--max-deg", maxDeg, "heat map: degrees at the top of the ramp")->capture_default_str();
     mont->add_option("--exposure", exposure, "exposure before the tone map")->capture_default_str();
     std::vector<std::string> channels;
@@ -137,6 +152,7 @@ int main(int argc, char** argv) {
         const std::string stagedJson = jsonPath.empty() ? "" : outputs.add(jsonPath);
         if (image->parsed()) {
             const std::string stagedHeat = heatPath.empty() ? "" : outputs.add(heatPath);
+            const std::string stagedFlip = flipPath.empty() ? "" : outputs.add(flipPath);
             EvalBuffer ref = readEvalBuffer(refPath), test = readEvalBuffer(testPath);
             nlohmann::json r = compareImages(ref, test, exposure);
             r["ref"] = refPath;
@@ -152,8 +168,19 @@ int main(int argc, char** argv) {
                         r["coverage"]["ref"].get<size_t>(), r["coverage"]["test"].get<size_t>(),
                         r["coverage"]["mismatch"].get<size_t>(), r["coverage"]["refOnly"].get<size_t>(),
                         r["coverage"]["testOnly"].get<size_t>());
-            std::printf("tone-mapped: PSNR %.2f dB, SSIM %.4f\n", r["psnr"].get<double>(), r["ssim"].get<double>());
+            std::printf("tone-mapped: PSNR %.2f dB, SSIM %.4f, FLIP %.4f\n", r["psnr"].get<double>(),
+                        r["ssim"].get<double>(), r["flip"].get<double>());
+            // The object metrics are null where undefined (no object pixel, no window, no detail).
+            auto number = [](const nlohmann::json& v, int digits) {
+                char s[32] = "-";
+                if (!v.is_null()) std::snprintf(s, sizeof s, "%.*f", digits, v.get<double>());
+                return std::string(s);
+            };
+            std::printf("object (reference coverage): PSNR %s dB, SSIM %s, FLIP %s, detail ratio %s\n",
+                        number(r["objectPsnr"], 2).c_str(), number(r["objectSsim"], 4).c_str(),
+                        number(r["objectFlip"], 4).c_str(), number(r["detailRatio"], 3).c_str());
             if (!heatPath.empty()) writePng8(stagedHeat, heatMap(ref, test, maxDeg, exposure));
+            if (!flipPath.empty()) writePng8(stagedFlip, flipHeatMap(ref, test, exposure));
             if (!jsonPath.empty()) writeFile(stagedJson, r.dump(2) + "\n");
             outputs.commit();
             return cli::kOk;
@@ -174,21 +201,32 @@ int main(int argc, char** argv) {
                                  std::to_string(inputs.size()) + " inputs");
             std::vector<EvalBuffer> buffers;
             for (const std::string& p : inputs) buffers.push_back(readEvalBuffer(p));
-            std::vector<std::vector<Image8>> rows(withErrors ? 2 : 1);
+            const size_t errorRow = 1, flipRow = withErrors ? 2 : 1;
+            std::vector<std::vector<Image8>> rows(1 + withErrors + withFlip);
             std::vector<std::vector<std::string>> text(rows.size());
             for (size_t i = 0; i < buffers.size(); ++i) {
                 rows[0].push_back(toneMapped(buffers[i], exposure));
                 text[0].push_back(labels.empty() ? std::filesystem::path(inputs[i]).stem().string() : labels[i]);
-                if (!withErrors) continue;
+                if (!withErrors && !withFlip) continue;
                 nlohmann::json r = compareImages(buffers[0], buffers[i], exposure);
-                rows[1].push_back(heatMap(buffers[0], buffers[i], maxDeg, exposure));
                 char line[64];
-                if (r["angleDeg"]["count"].get<size_t>() > 0)
-                    std::snprintf(line, sizeof line, "median %.1f p95 %.1f deg",
-                                  r["angleDeg"]["median"].get<double>(), r["angleDeg"]["p95"].get<double>());
-                else
-                    std::snprintf(line, sizeof line, "no overlap");
-                text[1].push_back(line);
+                if (withErrors) {
+                    rows[errorRow].push_back(heatMap(buffers[0], buffers[i], maxDeg, exposure));
+                    if (r["angleDeg"]["count"].get<size_t>() > 0)
+                        std::snprintf(line, sizeof line, "median %.1f p95 %.1f deg",
+                                      r["angleDeg"]["median"].get<double>(), r["angleDeg"]["p95"].get<double>());
+                    else
+                        std::snprintf(line, sizeof line, "no overlap");
+                    text[errorRow].push_back(line);
+                }
+                if (withFlip) {
+                    rows[flipRow].push_back(flipHeatMap(buffers[0], buffers[i], exposure));
+                    if (!r["objectFlip"].is_null())
+                        std::snprintf(line, sizeof line, "object FLIP %.3f", r["objectFlip"].get<double>());
+                    else
+                        std::snprintf(line, sizeof line, "no object");
+                    text[flipRow].push_back(line);
+                }
             }
             writePng8(stagedPng, montage(rows, text, 2));
             outputs.commit();

@@ -1,6 +1,7 @@
 // Image metrics, the evaluation EXR layout and the reference camera, against known answers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include "common/evalbuffer.h"
 #include "common/latlong.h"
 #include "common/scene.h"
+#include "common/tonemap.h"
 
 using namespace shrefract;
 
@@ -28,6 +30,34 @@ EvalBuffer randomBuffer(int w, int h, unsigned seed) {
         b.direction.push_back(i % 3 ? glm::normalize(glm::vec3(u(rng), u(rng), u(rng))) : glm::vec3(0));
     }
     return b;
+}
+
+// The grey level whose tone-mapped value is `v` (toneMapAces is increasing on grey): bisection.
+float greyFor(float v) {
+    float lo = 0.0f, hi = 16.0f;
+    for (int k = 0; k < 60; ++k) {
+        const float mid = 0.5f * (lo + hi);
+        (toneMapAces(glm::vec3(mid)).x < v ? lo : hi) = mid;
+    }
+    return 0.5f * (lo + hi);
+}
+
+// The buffer's colours blurred with the 3 x 3 binomial kernel (clamp to edge).
+EvalBuffer blurred(const EvalBuffer& b) {
+    EvalBuffer out = b;
+    const float k[3] = {0.25f, 0.5f, 0.25f};
+    for (int y = 0; y < b.height; ++y)
+        for (int x = 0; x < b.width; ++x) {
+            glm::vec3 s(0);
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const int xx = std::clamp(x + dx, 0, b.width - 1), yy = std::clamp(y + dy, 0, b.height - 1);
+                    s += k[dx + 1] * k[dy + 1] * glm::vec3(b.color[size_t(yy) * b.width + xx]);
+                }
+            glm::vec4& c = out.color[size_t(y) * b.width + x];
+            c = glm::vec4(s, c.a);
+        }
+    return out;
 }
 
 }  // namespace
@@ -76,6 +106,105 @@ TEST(ImageEval, SsimDropsWithNoiseAndIsSymmetric) {
     EXPECT_LT(s, 0.9);
     EXPECT_GT(s, 0.0);
     EXPECT_NEAR(s, ssim(b, a, w, h), 1e-12);
+}
+
+TEST(ImageEval, IdenticalImagesHaveObjectMetricsOfNoError) {
+    EvalBuffer a = randomBuffer(32, 24, 5);
+    nlohmann::json r = compareImages(a, a);
+    EXPECT_EQ(r["objectPsnr"].get<double>(), 99.0);
+    EXPECT_NEAR(r["objectSsim"].get<double>(), 1.0, 1e-9);
+    EXPECT_EQ(r["detailRatio"].get<double>(), 1.0);
+    EXPECT_EQ(r["objectFlip"].get<double>(), 0.0);
+    EXPECT_EQ(r["flip"].get<double>(), 0.0);
+}
+
+// The object is the left half; the test differs from the reference only at x >= 30, farther from
+// it than any window reaches (SSIM 5, detail blur 6, FLIP's CSF 10 and feature detectors 9 pixels):
+// every object metric reads no error, the whole-frame ones do.
+TEST(ImageEval, ObjectMetricsSeeOnlyTheObject) {
+    EvalBuffer ref = randomBuffer(40, 40, 8), test = ref;
+    for (int y = 0; y < 40; ++y)
+        for (int x = 0; x < 40; ++x) {
+            const size_t i = size_t(y) * 40 + x;
+            ref.color[i].a = test.color[i].a = x < 20 ? 1.0f : 0.0f;
+            if (x >= 30) test.color[i] = glm::vec4(glm::vec3(2.0f) - glm::vec3(ref.color[i]), 0.0f);
+        }
+    nlohmann::json r = compareImages(ref, test);
+    EXPECT_EQ(r["objectPsnr"].get<double>(), 99.0);
+    EXPECT_NEAR(r["objectSsim"].get<double>(), 1.0, 1e-9);
+    EXPECT_EQ(r["detailRatio"].get<double>(), 1.0);
+    EXPECT_EQ(r["objectFlip"].get<double>(), 0.0);
+    EXPECT_LT(r["psnr"].get<double>(), 30.0);
+    EXPECT_LT(r["ssim"].get<double>(), 0.9);
+    EXPECT_GT(r["flip"].get<double>(), 0.05);
+}
+
+// A 4 x 3 image, the reference covering pixels 1, 5, 6 and 10 (the test others): objectPsnr is
+// the PSNR of the tone-mapped RGB over those four alone.
+TEST(ImageEval, ObjectPsnrIsThePsnrOverTheReferenceCoverage) {
+    EvalBuffer ref = randomBuffer(4, 3, 11), test = randomBuffer(4, 3, 12);
+    const std::vector<size_t> mask = {1, 5, 6, 10};
+    for (size_t i = 0; i < ref.pixelCount(); ++i) {
+        ref.color[i].a = std::count(mask.begin(), mask.end(), i) ? 1.0f : 0.0f;
+        test.color[i].a = 1.0f - ref.color[i].a;
+    }
+    double se = 0;
+    for (size_t i : mask) {
+        const glm::vec3 d = toneMapAces(glm::vec3(ref.color[i])) - toneMapAces(glm::vec3(test.color[i]));
+        se += glm::dot(d, d);
+    }
+    const double expected = 10.0 * std::log10(1.0 / (se / (3.0 * mask.size())));
+    nlohmann::json r = compareImages(ref, test);
+    EXPECT_NEAR(r["objectPsnr"].get<double>(), expected, 1e-6);
+    EXPECT_NE(r["objectPsnr"].get<double>(), r["psnr"].get<double>());
+    EXPECT_TRUE(r["objectSsim"].is_null());  // smaller than one SSIM window
+    // No object pixel: the object metrics are undefined.
+    for (glm::vec4& c : ref.color) c.a = 0.0f;
+    r = compareImages(ref, test);
+    for (const char* key : {"objectPsnr", "objectSsim", "detailRatio", "objectFlip"})
+        EXPECT_TRUE(r[key].is_null()) << key;
+}
+
+TEST(ImageEval, DetailRatioFallsWithBlur) {
+    EvalBuffer a = randomBuffer(40, 32, 7);
+    EXPECT_EQ(compareImages(a, a)["detailRatio"].get<double>(), 1.0);
+    const double blurredRatio = compareImages(a, blurred(a))["detailRatio"].get<double>();
+    EXPECT_LT(blurredRatio, 0.9);
+    EXPECT_GT(compareImages(blurred(a), a)["detailRatio"].get<double>(), 1.1);  // noisier than the reference
+}
+
+// A one-pixel checkerboard of tone-mapped luminance m +- d, and the same blurred by the kernel
+// [1/8, 3/4, 1/8] along x and y, which scales the alternating pattern by (3/4 - 2/8)^2 = 1/4:
+// m +- d/4. On an alternating pattern the sigma-2 blur is a fixed factor r, so |L - G2 * L| is
+// d |1 - r| against d/4 |1 - r|: the detail ratio is 1/4 exactly, on object pixels at least the
+// blur's radius (6) from the border.
+TEST(ImageEval, DetailRatioOfABlurredCheckerboardIsAQuarter) {
+    const int w = 32, h = 24;
+    const float m = 0.5f, d = 0.2f;
+    EvalBuffer ref, test;
+    ref.width = test.width = w, ref.height = test.height = h;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const float s = (x + y) % 2 ? 1.0f : -1.0f;
+            const bool inside = x >= 6 && y >= 6 && x < w - 6 && y < h - 6;
+            ref.color.emplace_back(glm::vec3(greyFor(m + s * d)), inside ? 1.0f : 0.0f);
+            test.color.emplace_back(glm::vec3(greyFor(m + s * d / 4)), 1.0f);
+            ref.direction.emplace_back(0, 0, 1), test.direction.emplace_back(0, 0, 1);
+        }
+    EXPECT_NEAR(compareImages(ref, test)["detailRatio"].get<double>(), 0.25, 1e-3);
+}
+
+TEST(ImageEval, FlipHeatMapColoursEveryPixelAndAddsALegend) {
+    EvalBuffer a = randomBuffer(24, 16, 2);
+    Image8 same = flipHeatMap(a, a);
+    ASSERT_EQ(same.width, 24);
+    ASSERT_EQ(same.height, 16 + 24);
+    const glm::u8vec3 zero = errorColor(0.0f, 1.0f);
+    for (int i = 0; i < 24 * 16; ++i)
+        ASSERT_EQ(glm::u8vec3(same.rgb[3 * i], same.rgb[3 * i + 1], same.rgb[3 * i + 2]), zero) << i;
+    Image8 diff = flipHeatMap(a, blurred(a));
+    EXPECT_NE(std::vector<uint8_t>(diff.rgb.begin(), diff.rgb.begin() + 24 * 16 * 3),
+              std::vector<uint8_t>(same.rgb.begin(), same.rgb.begin() + 24 * 16 * 3));
 }
 
 // The reference camera is glm's: the ray through a pixel centre projects back onto it.

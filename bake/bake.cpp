@@ -86,6 +86,7 @@ BakeStats BakeStats::fromJson(const nlohmann::json& j) {
 struct BakePlan::Compression {
     Eigen::MatrixXf Mt;
     std::unique_ptr<WeightedFitter> fitter;  // Fit::Weighted only
+    std::unique_ptr<ResidualFitter> residual;  // the error model, when the bake stores one
     std::vector<double> h;                   // band filter, per band
     std::vector<int> band;                   // band of each stored coefficient
     std::vector<glm::vec3> dirs;             // grid directions, local frame
@@ -125,6 +126,8 @@ void BakePlan::prepareTracing() const {
             for (int k = 0; k < K; ++k) Md.row(k) *= c->h[c->band[k]];
             c->Mt = Md.transpose().cast<float>();
         }
+        if (opt_.errorOrder >= 0)
+            c->residual = std::make_unique<ResidualFitter>(opt_.grid, opt_.order, opt_.errorOrder);
         c->dirs.resize(J);
         for (int j = 0; j < J; ++j) c->dirs[j] = glm::vec3(opt_.grid.direction(j));
         c->order = packetOrder(opt_.grid.nTheta, opt_.grid.nPhi);
@@ -158,6 +161,8 @@ SliceResult BakePlan::bakeSlice(size_t beginBatch, size_t endBatch, const SliceP
     out.first = std::min(beginBatch * kBakeBatch, n);
     out.count = std::min(endBatch * kBakeBatch, n) - out.first;
     out.weights.assign(size_t(K) * out.count * 4, 0.0f);
+    const int Ke = compression.residual ? compression.residual->errorCoefficients() : 0;
+    out.errors.assign(size_t(Ke) * out.count, 0.0f);
     const size_t first = out.first, count = out.count;
 
     std::atomic<size_t> done{0}, rays{0};
@@ -168,7 +173,7 @@ SliceResult BakePlan::bakeSlice(size_t beginBatch, size_t endBatch, const SliceP
 
     tbb::parallel_for(tbb::blocked_range<size_t>(beginBatch, endBatch, 1), [&](const tbb::blocked_range<size_t>& range) {
         enableFlushToZero();
-        Eigen::MatrixXf R(J, 4 * kBakeBatch), Wt(4 * kBakeBatch, K), W(K, 4);
+        Eigen::MatrixXf R(J, 4 * kBakeBatch), Wt(4 * kBakeBatch, K), W(K, 4), E(Ke, kBakeBatch);
         std::vector<glm::vec3> omegas(J);
         std::vector<PathResult> paths(J);
         std::vector<PathResult> batchPaths(weighted ? size_t(J) * kBakeBatch : 0);  // [s * J + j]
@@ -221,10 +226,16 @@ SliceResult BakePlan::bakeSlice(size_t beginBatch, size_t endBatch, const SliceP
             } else {
                 Wt.noalias() = R.transpose() * Mt;
             }
-            // 3. Store its weights.
+            // 3. Store its weights, and the error model of what they miss at the grid directions.
             for (int k = 0; k < K; ++k)
                 std::copy_n(Wt.col(k).data(), 4 * batchCount,
                             &out.weights[(size_t(k) * count + batchFirst - first) * 4]);
+            if (Ke > 0) {
+                compression.residual->fit(R, Wt, int(batchCount), E);
+                for (int k = 0; k < Ke; ++k)
+                    for (size_t s = 0; s < batchCount; ++s)
+                        out.errors[size_t(k) * count + batchFirst - first + s] = E(k, s);
+            }
             auto tEnd = Clock::now();
             traceNs += std::chrono::duration_cast<std::chrono::nanoseconds>(tGemm - tTrace).count();
             compressNs += std::chrono::duration_cast<std::chrono::nanoseconds>(tEnd - tGemm).count();
@@ -307,12 +318,15 @@ nlohmann::json BakePlan::manifest(const BakeStats& stats) const {
     };
 }
 
-BakeData BakePlan::data(std::vector<float> weights, const BakeStats& stats) const {
+BakeData BakePlan::data(std::vector<float> weights, std::vector<float> errors,
+                        const BakeStats& stats) const {
     BakeData d;
     d.order = opt_.order;
     d.precision = opt_.precision;
     d.layout = layout_;
     d.weights = std::move(weights);
+    d.errorOrder = opt_.errorOrder < 0 ? -1 : opt_.errorOrder;
+    d.errors = std::move(errors);
     d.manifest = manifest(stats);
     return d;
 }
@@ -335,7 +349,7 @@ BakeResult bake(const Scene& scene, const BakeOptions& opt, const std::string& i
     out.stats.wallSeconds = secondsSince(t0);
     out.stats.rhoOverhead = rhoOverhead(plan.layout());
     out.stats.charts = plan.chartStats();
-    out.data = plan.data(std::move(all.weights), out.stats);
+    out.data = plan.data(std::move(all.weights), std::move(all.errors), out.stats);
     return out;
 }
 

@@ -15,10 +15,10 @@
 
 #include "bake/charts.h"
 #include "bake/fit.h"
+#include "bake/residual.h"
 #include "bake/tracer.h"
 #include "common/bakefile.h"
 #include "common/direction_grid.h"
-#include "common/error.h"
 #include "common/error.h"
 #include "common/scene.h"
 
@@ -57,6 +57,7 @@ struct BakeOptions {
     double filterWidth = 0.0;  // semi-Gaussian width in bands; <= 0: none
     Fit fit = Fit::Weighted;  // the default by the charts (docs/bake.md "Fits"); the paper: Projection
     FitWeighting weighting;    // for Fit::Weighted
+    int errorOrder = kDefaultErrorOrder;  // the error model's SH order (bake/residual.h); < 0: none
     Precision precision = Precision::F32;
     int threads = 0;         // 0: all cores
     std::string cacheDir;    // compression matrix cache; empty: none
@@ -83,6 +84,7 @@ struct BakeStats {
 struct SliceResult {
     size_t first = 0, count = 0;  // samples [first, first + count)
     std::vector<float> weights;   // [(k * count + i) * 4 + c], as BakeData::weights
+    std::vector<float> errors;    // [k * count + i], as BakeData::errors (empty: no error model)
     BakeStats stats;              // samples, paths, rays, flags, seconds of this slice
 };
 
@@ -115,8 +117,9 @@ public:
     SliceResult bakeSlice(size_t beginBatch, size_t endBatch, const SliceProgress& base = {}) const;
     // The descriptive manifest of the whole bake (docs/format.md), "stats" from `stats`.
     nlohmann::json manifest(const BakeStats& stats) const;
-    // BakeData of the whole bake around `weights` (sampleCount x coefficients x 4).
-    BakeData data(std::vector<float> weights, const BakeStats& stats) const;
+    // BakeData of the whole bake around `weights` (sampleCount x coefficients x 4) and the error
+    // model's `errors` (sampleCount x error coefficients; empty when options().errorOrder < 0).
+    BakeData data(std::vector<float> weights, std::vector<float> errors, const BakeStats& stats) const;
     // XXH3-64 of the samples' positions, normals and parts: what the tracing saw.
     std::string layoutChecksum() const;
 

@@ -16,6 +16,7 @@
 
 #include "bake/layout.h"
 #include "common/error.h"
+#include "common/limits.h"
 #include "common/sh.h"
 
 namespace shrefract {
@@ -87,6 +88,9 @@ BakeOptions optionsOf(const json& id) {
     o.trace.branch = id.value("branch", "") == "transmit" ? Branch::Transmit : Branch::Fresnel;
     o.trace.maxBounces = id.value("maxBounces", 32);
     o.coherent = id.value("tracer", "coherent") == "coherent";
+    o.errorOrder = id.value("errorOrder", -1);
+    if (o.errorOrder > limits::kMaxErrorOrder)
+        throw InputError(str("error model order ", o.errorOrder, " is above ", limits::kMaxErrorOrder));
     o.cacheDir = "";
     return o;
 }
@@ -173,6 +177,7 @@ json shardIdentity(const BakePlan& plan) {
     id["sampleCount"] = plan.sampleCount();
     id["batch"] = kBakeBatch;
     id["layoutChecksum"] = plan.layoutChecksum();
+    id["errorOrder"] = o.errorOrder < 0 ? -1 : o.errorOrder;
     return id;
 }
 
@@ -183,6 +188,8 @@ ShardData bakeShard(const BakePlan& plan, ShardSlice slice, const SliceProgress&
     d.order = plan.options().order;
     d.sampleCount = r.count;
     d.weights = std::move(r.weights);
+    d.errorOrder = plan.options().errorOrder < 0 ? -1 : plan.options().errorOrder;
+    d.errors = std::move(r.errors);
     d.manifest = {{"shard", {{"index", slice.index}, {"count", slice.count}, {"first", r.first},
                              {"samples", r.count}, {"batches", {b0, b1}}}},
                   {"bake", shardIdentity(plan)},
@@ -202,6 +209,10 @@ std::string shardMismatch(const ShardData& shard, const json& identity, ShardSli
     const auto [b0, b1] = shardBatches(batches, s);
     const size_t n = identity.value("sampleCount", size_t(0));
     const size_t first = std::min(b0 * kBakeBatch, n), count = std::min(b1 * kBakeBatch, n) - first;
+    const int errorOrder = identity.value("errorOrder", -1);
+    if (shard.errorOrder != errorOrder || shard.errors.size() != (errorOrder < 0 ? 0 : size_t(shEvenCount(errorOrder))) * shard.sampleCount)
+        return str("its error model (order ", shard.errorOrder, ", ", shard.errors.size(),
+                   " values) is not the bake's (order ", errorOrder, ")");
     if (m["shard"].value("first", size_t(-1)) != first || shard.sampleCount != count)
         return str("its samples (", m["shard"].value("first", size_t(0)), " + ", shard.sampleCount,
                    ") are not ", sliceName(s), "'s (", first, " + ", count, ")");
@@ -248,6 +259,8 @@ BakeResult mergeShards(const BakePlan& plan, const std::vector<std::string>& pat
 
     // The weights, slice by slice, each verified as it is read.
     std::vector<float> weights(size_t(K) * n * 4, 0.0f);
+    const int Ke = plan.options().errorOrder < 0 ? 0 : shEvenCount(plan.options().errorOrder);
+    std::vector<float> errors(size_t(Ke) * n, 0.0f);
     BakeStats stats;
     for (const auto& [index, p] : byIndex) {
         const ShardData s = readShard(p, true);
@@ -257,13 +270,15 @@ BakeResult mergeShards(const BakePlan& plan, const std::vector<std::string>& pat
         for (int k = 0; k < K; ++k)
             std::copy_n(&s.weights[size_t(k) * s.sampleCount * 4], s.sampleCount * 4,
                         &weights[(size_t(k) * n + first) * 4]);
+        for (int k = 0; k < Ke; ++k)
+            std::copy_n(&s.errors[size_t(k) * s.sampleCount], s.sampleCount, &errors[size_t(k) * n + first]);
         stats += BakeStats::fromJson(s.manifest.value("stats", json::object()));
     }
     BakeResult out;
     stats.samples = n;
     stats.rhoOverhead = rhoOverhead(plan.layout());
     out.stats = stats;
-    out.data = plan.data(std::move(weights), stats);
+    out.data = plan.data(std::move(weights), std::move(errors), stats);
     return out;
 }
 

@@ -11,9 +11,13 @@
 
 namespace shrefract {
 
-// 2: per-part and manifest checksums, the layout kind and the chart layouts (docs/format.md
-// "Versions"). Readers take version 1 too, unverified, as a joining layout.
-constexpr int kFormatVersion = 2;
+// 2: per-part and manifest checksums, the layout kind and the chart layouts; 3: the error model
+// (docs/format.md "Versions"). Readers take version 1 too, unverified, as a joining layout.
+constexpr int kFormatVersion = 3;
+
+// The error model stores ln(angle + kErrorOffset) (radians): the offset keeps the logarithm of an
+// exact fit finite, and a prediction at or below it reads as no error at all.
+constexpr float kErrorOffset = 0.01f;
 
 // How the surface samples are laid out (manifest "layout.kind"):
 //   Joining   paper §5.3: every triangle sampled on a barycentric grid, mu packed, rho with
@@ -129,7 +133,14 @@ struct BakeData {
     // For U8 only: per coefficient k and channel c, value = scale * code + offset.
     std::vector<float> u8Scale, u8Offset;  // shEvenCount(order) * 4 each
 
+    // The bake's model of its own angular error (docs/format.md "error"): per sample the even SH
+    // through errorOrder of ln(angle + kErrorOffset), the angle in radians between the fitted and
+    // the traced exit. errors[k * sampleCount + i]; errorOrder < 0 (files before version 3): none.
+    int errorOrder = -1;
+    std::vector<float> errors;
+
     int coefficientCount() const;  // shEvenCount(order)
+    int errorCoefficientCount() const;  // shEvenCount(errorOrder), 0 without a model
 
     // Not stored: what readBake noticed that the caller should tell the user (e.g. a version 1
     // file, which carries no checksums).
@@ -160,6 +171,8 @@ struct ShardData {
     int order = 8;              // L
     size_t sampleCount = 0;     // samples in this slice
     std::vector<float> weights; // [(k * sampleCount + i) * 4 + c], as BakeData::weights
+    int errorOrder = -1;        // the error model, as BakeData's
+    std::vector<float> errors;  // [k * sampleCount + i]
 };
 
 // Writes a shard all or nothing, as writeBake does (uncompressed: float weights hardly compress).

@@ -8,6 +8,7 @@
 
 #include "common/error.h"
 #include "common/frame.h"
+#include "common/prefilter.h"
 #include "common/sh.h"
 
 namespace shrefract {
@@ -35,6 +36,26 @@ glm::vec4 decompressSample(const BakeData& bake, int i, glm::vec3 wLocal, int or
         d += basis[k] * glm::vec4(w[0], w[1], w[2], w[3]);
     }
     return d;
+}
+
+float predictedError(const BakeData& bake, int i, glm::vec3 wLocal) {
+    if (bake.errorOrder < 0) return -1.0f;
+    const int Ke = bake.errorCoefficientCount();
+    float basis[32];
+    SHREFRACT_CHECK(Ke <= 32);
+    shEvalEven(bake.errorOrder, glm::normalize(wLocal), basis);
+    const size_t n = bake.layout.position.size();
+    float e = 0.0f;
+    for (int k = 0; k < Ke; ++k) e += basis[k] * bake.errors[k * n + i];
+    return std::max(std::exp(e) - kErrorOffset, 0.0f);
+}
+
+glm::vec4 foldedSample(const BakeData& bake, int i, glm::vec3 wLocal) {
+    glm::vec4 d = decompressSample(bake, i, wLocal);
+    if (bake.errorOrder < 0) return d;
+    const float len = glm::length(glm::vec3(d));
+    const glm::vec3 dir = len > 1e-10f ? glm::vec3(d) / len : glm::vec3(0.0f);
+    return glm::vec4(dir * resultantOfSigma(predictedError(bake, i, wLocal)), d.w);
 }
 
 glm::vec4 interpolateRho(const SurfaceLayout& layout, const glm::vec4* values, int t, float u,

@@ -22,6 +22,18 @@ glm::vec3 localViewFromEye(const SurfaceLayout& layout, int i, glm::vec3 eye);
 // exit direction in object space and NOT normalized (the runtime normalizes after filtering).
 glm::vec4 decompressSample(const BakeData& bake, int i, glm::vec3 wLocal, int order = -1);
 
+// The bake's predicted angular error (radians, >= 0) of sample i's exit at the local view
+// direction wLocal: its error model (BakeData::errors) evaluated there, exp(.) - kErrorOffset,
+// clamped at 0. -1 when
+// the bake has no error model (files before version 3, or baked with --error-order -1).
+float predictedError(const BakeData& bake, int i, glm::vec3 wLocal);
+
+// D at sample i as the runtime's texture-space passes leave it for interpolation (the CPU twin of
+// decompression plus shaders/error_fold.frag): decompressSample, and where the bake has an error
+// model, the exit vector's length set to resultantOfSigma(predictedError), the vMF lobe the
+// shading reads back.
+glm::vec4 foldedSample(const BakeData& bake, int i, glm::vec3 wLocal);
+
 // Where a point lies in the rho interpolation: triangle t, barycentric (u, v) for corners 1, 2.
 // Returns the value the runtime's bilinear lookup in rho yields there (with interpolation
 // correction): bilinear over the grid cell, the cell's missing corner past the hypotenuse being

@@ -10,6 +10,8 @@
 //   "chart_vertices"  P.x P.y P.z N.x N.y N.z u v (FLOAT), chart (UINT)
 //   "chart_triangles" a b c (UINT)
 //   "seam_sources"    texel s0 s1 s2 s3 (UINT), w0 w1 w2 w3 (FLOAT)
+// Bakes with an error model (version 3, manifest "errorModel") add, sample i where the weights are:
+//   "error"           mu layout   e### (FLOAT), the SH of ln(the fit's angular error + 0.01 rad)
 // The JSON manifest sits in the string attribute "shrefract.manifest" of every part, its XXH3-64
 // in "shrefract.manifestChecksum"; the manifest's "checksums" hold each part's (version 2).
 #include <Iex.h>
@@ -70,6 +72,7 @@ Precision parsePrecision(const std::string& text) {
 }
 
 int BakeData::coefficientCount() const { return shEvenCount(order); }
+int BakeData::errorCoefficientCount() const { return errorOrder < 0 ? 0 : shEvenCount(errorOrder); }
 
 namespace {
 
@@ -86,6 +89,9 @@ constexpr const char* kNeighbourListPart = "neighbour_list";
 constexpr const char* kChartVerticesPart = "chart_vertices";
 constexpr const char* kChartTrianglesPart = "chart_triangles";
 constexpr const char* kSeamSourcesPart = "seam_sources";
+constexpr const char* kErrorPart = "error";
+constexpr const char* kErrorModelKey = "errorModel";
+const uint64_t kMaxErrorTexelValues = uint64_t(shEvenCount(limits::kMaxErrorOrder));
 constexpr uint32_t kNoSample = UINT32_MAX;
 // Rows staged per writePixels/readPixels call for the weights part (a ZIP block is 16 lines), so
 // that the weights are never duplicated in memory at full size.
@@ -183,6 +189,16 @@ std::vector<Channel> weightChannels(int K, Precision p) {
             for (const char* s : kWeightSuffix)
                 ch.push_back({weightChannel(k, s), p == Precision::F16 ? Imf::HALF : Imf::FLOAT});
         }
+    }
+    return ch;
+}
+// The error model's channels: e000, e001, ... one FLOAT per coefficient.
+std::vector<Channel> errorChannels(int Ke) {
+    std::vector<Channel> ch;
+    for (int k = 0; k < Ke; ++k) {
+        char name[32];
+        std::snprintf(name, sizeof name, "e%03d", k);
+        ch.push_back({name, Imf::FLOAT});
     }
     return ch;
 }
@@ -351,6 +367,11 @@ std::string inconsistency(const BakeData& d) {
     if (L.normal.size() != N || L.part.size() != N)
         return str("per-sample arrays differ in size: position ", N, ", normal ", L.normal.size(),
                    ", part ", L.part.size());
+    if (d.errorOrder < -1 || d.errorOrder > limits::kMaxErrorOrder)
+        return str("error model order ", d.errorOrder, " is not in [-1, ", limits::kMaxErrorOrder, "]");
+    if (d.errors.size() != size_t(d.errorCoefficientCount()) * N)
+        return str(d.errors.size(), " error model values, expected ", d.errorCoefficientCount(),
+                   " coefficients x ", N, " samples");
     if (L.muWidth < 1 || L.muHeight < 1)
         return str("mu layout is ", L.muWidth, " x ", L.muHeight, " texels");
     if (N > size_t(L.muWidth) * size_t(L.muHeight))
@@ -495,6 +516,33 @@ void writeWhole(Imf::MultiPartOutputFile& file, int part, Planes& planes, int he
     Imf::OutputPart out(file, part);
     out.setFrameBuffer(planes.frameBuffer(0));
     out.writePixels(height);
+}
+
+uint32_t sampleOfTexel(const uint32_t* map, size_t texel, size_t N);
+
+// The error model's part: errors[k * N + i] at sample i's texel (`map` as for the weights).
+Planes errorPlanes(const float* errors, size_t N, int Ke, int width, int height, const uint32_t* map) {
+    Planes p(width, height, errorChannels(Ke));
+    for (size_t t = 0; t < size_t(width) * height; ++t) {
+        const uint32_t i = sampleOfTexel(map, t, N);
+        if (i == kNoSample) continue;
+        for (int k = 0; k < Ke; ++k) {
+            const float e = errors[size_t(k) * N + i];
+            if (!std::isfinite(e))
+                throw std::invalid_argument(str("error model value ", k, " of sample ", i, " is not finite"));
+            p.setF(t, k, e);
+        }
+    }
+    return p;
+}
+
+// The manifest's "errorModel" object: what the part holds and how to read it.
+json errorModelInfo(int order) {
+    return {{"order", order},
+            {"coefficients", shEvenCount(order)},
+            {"quantity", "ln(angle + offset), the angle in radians between the fitted and the traced exit"},
+            {"offset", kErrorOffset},
+            {"unit", "radians"}};
 }
 
 // The sample at texel `texel` (kNoSample: none): `map` for chart layouts (texelSamples), else
@@ -764,6 +812,35 @@ void readWeights(Imf::MultiPartInputFile& file, int part, const WeightsPart& sha
     verifier.check(kWeightsPart, sum.hex());
 }
 
+// The order of the manifest's "errorModel", checked against its coefficient count.
+int readErrorOrder(const json& m) {
+    const json& e = m[kErrorModelKey];
+    if (!e.is_object()) throw InputError("manifest \"errorModel\" is not an object");
+    const int order = manifestInt(e, "order");
+    if (order < 0 || order > limits::kMaxErrorOrder)
+        throw InputError(str("error model order ", order, " is not in [0, ", limits::kMaxErrorOrder, "]"));
+    if (manifestInt(e, "coefficients") != shEvenCount(order))
+        throw InputError(str("error model says ", manifestInt(e, "coefficients"), " coefficients, order ",
+                             order, " has ", shEvenCount(order)));
+    return order;
+}
+
+// The error part into errors[k * N + i], verified.
+std::vector<float> readErrors(Imf::MultiPartInputFile& file, int part, size_t N, int Ke, int width,
+                              int height, const uint32_t* map, const Verifier& verifier) {
+    const std::vector<Channel> channels = errorChannels(Ke);
+    checkPart(file.header(part), kErrorPart, width, height, channels);
+    Planes planes(width, height, channels);
+    readWhole(file, part, planes, height, verifier, kErrorPart);
+    std::vector<float> errors(size_t(Ke) * N, 0.0f);
+    for (size_t t = 0; t < size_t(width) * height; ++t) {
+        const uint32_t i = sampleOfTexel(map, t, N);
+        if (i == kNoSample) continue;
+        for (int k = 0; k < Ke; ++k) errors[size_t(k) * N + i] = planes.f(t, k);
+    }
+    return errors;
+}
+
 // The manifest text of part 0, checked against its checksum and the copies in the other parts.
 std::string manifestText(Imf::MultiPartInputFile& file, int version, bool verify) {
     const auto* text = file.header(0).findTypedAttribute<Imf::StringAttribute>(kManifestAttribute);
@@ -950,6 +1027,7 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options, ui
     // bytes: sizes beyond that are corrupt, and are refused before anything is allocated.
     const uint64_t muTexels = uint64_t(L.muWidth) * uint64_t(L.muHeight);
     const uint64_t pixelBytes = muTexels * weightsTexelBytes(K, d.precision) + muTexels * (28 + 8) +
+                                (m.contains(kErrorModelKey) ? muTexels * 4 * kMaxErrorTexelValues : 0) +
                                 uint64_t(L.rhoWidth) * uint64_t(L.rhoHeight) * 16 +
                                 uint64_t(nlWidth) * uint64_t(std::max(nlHeight, 0)) * 8;
     if (pixelBytes > 1100 * fileBytes + (1u << 20))
@@ -1016,6 +1094,11 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options, ui
         L.neighbourWeight[e] = list.f(e, 1);
     }
     if (L.isChartLayout()) readChartParts(file, find, layoutInfo, verifier, L.atlas);
+    if (version >= 3 && m.contains(kErrorModelKey)) {
+        d.errorOrder = readErrorOrder(m);
+        d.errors = readErrors(file, find(kErrorPart), size_t(N), d.errorCoefficientCount(), L.muWidth,
+                              L.muHeight, texelMap.empty() ? nullptr : texelMap.data(), verifier);
+    }
 
     const std::string problem = inconsistency(d);
     if (!problem.empty()) throw InputError("inconsistent bake: " + problem);
@@ -1059,6 +1142,15 @@ ShardData readShardParts(Imf::MultiPartInputFile& file, bool weights) {
         d.weights.assign(size_t(K) * d.sampleCount * 4, 0.0f);
         readWeights(file, part, {nullptr, d.sampleCount, K, Precision::F32, size[0], size[1]},
                     d.weights.data(), U8Params{}, verifier);
+        if (m.contains(kErrorModelKey)) {
+            d.errorOrder = readErrorOrder(m);
+            int errorPart = -1;
+            for (int p = 0; p < file.parts(); ++p)
+                if (file.header(p).hasName() && file.header(p).name() == kErrorPart) errorPart = p;
+            if (errorPart < 0) throw InputError(str("missing part \"", kErrorPart, "\""));
+            d.errors = readErrors(file, errorPart, d.sampleCount, shEvenCount(d.errorOrder), size[0],
+                                  size[1], nullptr, verifier);
+        }
     }
     d.manifest = std::move(m);
     return d;
@@ -1174,6 +1266,12 @@ void writeBake(const std::string& path, const BakeData& data) {
         }
     }
 
+    const int Ke = data.errorCoefficientCount();
+    std::unique_ptr<Planes> errors;
+    if (Ke > 0)
+        errors = std::make_unique<Planes>(errorPlanes(data.errors.data(), L.position.size(), Ke, L.muWidth,
+                                                      L.muHeight, texelMap.empty() ? nullptr : texelMap.data()));
+
     json m = data.manifest.is_null() ? json::object() : data.manifest;
     m["format"] = "shrefract";
     m["version"] = kFormatVersion;
@@ -1206,6 +1304,10 @@ void writeBake(const std::string& path, const BakeData& data) {
         m["u8"] = {{"scale", u8.scale}, {"offset", u8.offset}};
     else
         m.erase("u8");
+    if (errors)
+        m[kErrorModelKey] = errorModelInfo(data.errorOrder);
+    else
+        m.erase(kErrorModelKey);
     m["checksums"] = {{"algorithm", kChecksumAlgorithm},
                       {"parts",
                        {{kWeightsPart, weightsChecksum(weightsPart(data, texelMap), u8)},
@@ -1214,6 +1316,7 @@ void writeBake(const std::string& path, const BakeData& data) {
                         {kNeighboursPart, sum(neighbours)},
                         {kNeighbourListPart, sum(list)}}}};
     for (const ListPart& p : chartParts) m["checksums"]["parts"][p.name] = sum(p.planes);
+    if (errors) m["checksums"]["parts"][kErrorPart] = sum(*errors);
     std::string text;
     try {
         text = m.dump();
@@ -1237,6 +1340,10 @@ void writeBake(const std::string& path, const BakeData& data) {
         headers.push_back(partHeader(p.name, p.width, p.height, display, text));
         addChannels(headers.back(), p.channels);
     }
+    if (errors) {
+        headers.push_back(partHeader(kErrorPart, L.muWidth, L.muHeight, display, text));
+        addChannels(headers.back(), errorChannels(Ke));
+    }
 
     writeAtomically(path, [&](const std::string& staged) {
         writeExrFile(staged, [&](Imf::OStream& stream) {
@@ -1248,6 +1355,7 @@ void writeBake(const std::string& path, const BakeData& data) {
             writeWhole(file, 4, list, nlHeight);
             for (size_t p = 0; p < chartParts.size(); ++p)
                 writeWhole(file, int(5 + p), chartParts[p].planes, chartParts[p].height);
+            if (errors) writeWhole(file, int(5 + chartParts.size()), *errors, L.muHeight);
         });
     });
 }
@@ -1267,8 +1375,14 @@ void writeShard(const std::string& path, const ShardData& shard) {
     if (!shard.manifest.is_object() || !shard.manifest.contains("shard") ||
         !shard.manifest["shard"].is_object())
         throw std::invalid_argument("writeShard(" + path + "): the manifest has no \"shard\" object");
+    const int Ke = shard.errorOrder < 0 ? 0 : shEvenCount(shard.errorOrder);
+    if (shard.errorOrder > limits::kMaxErrorOrder || shard.errors.size() != size_t(Ke) * shard.sampleCount)
+        throw std::invalid_argument(str("writeShard(", path, "): ", shard.errors.size(),
+                                        " error model values, expected ", Ke, " x ", shard.sampleCount));
     const auto [width, height] = neighbourListSize(shard.sampleCount);
     const WeightsPart part{shard.weights.data(), shard.sampleCount, K, Precision::F32, width, height};
+    std::unique_ptr<Planes> errors;
+    if (Ke > 0) errors = std::make_unique<Planes>(errorPlanes(shard.errors.data(), shard.sampleCount, Ke, width, height, nullptr));
     json m = shard.manifest;
     m["format"] = "shrefract";
     m["version"] = kFormatVersion;
@@ -1279,6 +1393,12 @@ void writeShard(const std::string& path, const ShardData& shard) {
     m["weightsSize"] = {width, height};
     m["checksums"] = {{"algorithm", kChecksumAlgorithm},
                       {"parts", {{kWeightsPart, weightsChecksum(part, U8Params{})}}}};
+    if (errors) {
+        m[kErrorModelKey] = errorModelInfo(shard.errorOrder);
+        m["checksums"]["parts"][kErrorPart] = checksumHex(errors->bytes().data(), errors->bytes().size());
+    } else {
+        m.erase(kErrorModelKey);
+    }
     std::string text;
     try {
         text = m.dump();
@@ -1290,10 +1410,16 @@ void writeShard(const std::string& path, const ShardData& shard) {
                                                    Imath::Box2i({0, 0}, {width - 1, height - 1}),
                                                    text, Imf::NO_COMPRESSION)};
     addChannels(headers[0], weightChannels(K, Precision::F32));
+    if (errors) {
+        headers.push_back(partHeader(kErrorPart, width, height, Imath::Box2i({0, 0}, {width - 1, height - 1}),
+                                     text, Imf::NO_COMPRESSION));
+        addChannels(headers.back(), errorChannels(Ke));
+    }
     writeAtomically(path, [&](const std::string& staged) {
         writeExrFile(staged, [&](Imf::OStream& stream) {
             Imf::MultiPartOutputFile file(stream, headers.data(), int(headers.size()));
             writeWeights(file, 0, part, U8Params{});
+            if (errors) writeWhole(file, 1, *errors, height);
         });
     });
 }

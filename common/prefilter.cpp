@@ -98,4 +98,10 @@ float spreadSigma(float resultant, float scale) {
     return scale / std::sqrt(kappa);
 }
 
+float resultantOfSigma(float sigma) {
+    if (sigma < 1e-3f) return 1.0f;
+    const double kappa = 1.0 / (double(sigma) * sigma), e = std::exp(-2.0 * kappa);
+    return float((1.0 + e) / (1.0 - e) - 1.0 / kappa);
+}
+
 }  // namespace shrefract

@@ -41,5 +41,10 @@ glm::vec3 sampleCubeLod(const PrefilteredCube& cube, glm::vec3 d, float lod);
 // mapping scatters. kappa(R) = R (3 - R^2) / (1 - R^2) (Banerjee et al. 2005), sigma =
 // scale / sqrt(kappa); 0 at R >= 1, very wide as R -> 0. shading.glsl spreadSigma() is the twin.
 float spreadSigma(float resultant, float scale = 1.0f);
+// The inverse direction, exactly: the mean resultant length coth(kappa) - 1 / kappa of the vMF
+// lobe with kappa = 1 / sigma^2, 1 for sigma < 1e-3 (within float rounding). How the runtime
+// carries the bake's predicted error in the length of the exit vector (shaders/error_fold.frag
+// is the twin); spreadSigma(resultantOfSigma(s)) is s within Banerjee's approximation.
+float resultantOfSigma(float sigma);
 
 }  // namespace shrefract

@@ -92,6 +92,7 @@ nlohmann::json evaluateDirections(const BakeData& bake, const Scene& scene, size
     const bool haveGrid = m.contains("grid") && m["grid"].is_array() && m["grid"].size() == 2;
     if (haveGrid) grid.nTheta = m["grid"][0].get<int>(), grid.nPhi = m["grid"][1].get<int>();
     std::vector<double> angle(pairs), lenErr(pairs), ceilAngle(pairs), ceilLen(pairs);
+    std::vector<double> predicted(pairs), shortness(pairs);
     std::vector<uint32_t> flags(pairs);
     tbb::parallel_for(size_t(0), pairs, [&](size_t k) {
         enableFlushToZero();
@@ -104,6 +105,8 @@ nlohmann::json evaluateDirections(const BakeData& bake, const Scene& scene, size
         glm::vec4 d = decompressSample(bake, static_cast<int>(p.sample), p.omegaLocal, o);
         angle[k] = angleDegrees(glm::vec3(d), truth.exit);
         lenErr[k] = std::abs(double(d.w) - truth.length);
+        predicted[k] = predictedError(bake, int(p.sample), p.omegaLocal) * 180.0 / M_PI;
+        shortness[k] = 1.0 - glm::length(glm::vec3(d));
         flags[k] = truth.flags;
         if (haveGrid) {
             int index[4];
@@ -138,6 +141,23 @@ nlohmann::json evaluateDirections(const BakeData& bake, const Scene& scene, size
         return j;
     };
     const nlohmann::json all = subset(~0u);
+    nlohmann::json prediction = {{"spearmanShortness", spearman(shortness, angle)}};
+    if (bake.errorOrder >= 0) {
+        prediction["spearman"] = spearman(predicted, angle);
+        // Deciles of the prediction: its median and the measured median in each.
+        std::vector<size_t> byPrediction(pairs);
+        std::iota(byPrediction.begin(), byPrediction.end(), size_t(0));
+        std::sort(byPrediction.begin(), byPrediction.end(),
+                  [&](size_t a, size_t b) { return predicted[a] < predicted[b]; });
+        nlohmann::json bins = nlohmann::json::array();
+        for (int q = 0; q < 10 && pairs >= 10; ++q) {
+            std::vector<double> p, a;
+            for (size_t k = q * pairs / 10; k < (q + 1) * pairs / 10; ++k)
+                p.push_back(predicted[byPrediction[k]]), a.push_back(angle[byPrediction[k]]);
+            bins.push_back({{"predictedDeg", errorStats(p)["median"]}, {"measuredDeg", errorStats(a)["median"]}});
+        }
+        prediction["deciles"] = bins;
+    }
     return {{"pairs", pairs},
             {"seed", seed},
             {"order", order < 0 ? bake.order : std::min(order, bake.order)},
@@ -147,7 +167,34 @@ nlohmann::json evaluateDirections(const BakeData& bake, const Scene& scene, size
             {"tir", subset(kPathTIR)},
             {"capped", subset(kPathCapped)},
             {"reentered", subset(kPathReentered)},
-            {"plain", subset(0)}};
+            {"plain", subset(0)},
+            {"prediction", prediction}};
+}
+
+double spearman(const std::vector<double>& a, const std::vector<double>& b) {
+    SHREFRACT_CHECK(a.size() == b.size());
+    const size_t n = a.size();
+    auto ranks = [n](const std::vector<double>& x) {
+        std::vector<size_t> idx(n);
+        std::iota(idx.begin(), idx.end(), size_t(0));
+        std::sort(idx.begin(), idx.end(), [&](size_t p, size_t q) { return x[p] < x[q]; });
+        std::vector<double> r(n);
+        for (size_t s = 0; s < n;) {
+            size_t e = s;
+            while (e + 1 < n && x[idx[e + 1]] == x[idx[s]]) ++e;
+            for (size_t k = s; k <= e; ++k) r[idx[k]] = 0.5 * double(s + e);  // mean rank of the tie
+            s = e + 1;
+        }
+        return r;
+    };
+    const std::vector<double> ra = ranks(a), rb = ranks(b);
+    const double mean = 0.5 * double(n - 1);
+    double sab = 0, saa = 0, sbb = 0;
+    for (size_t k = 0; k < n; ++k) {
+        sab += (ra[k] - mean) * (rb[k] - mean);
+        saa += (ra[k] - mean) * (ra[k] - mean), sbb += (rb[k] - mean) * (rb[k] - mean);
+    }
+    return saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 0.0;
 }
 
 std::vector<int> adaptiveOrders(const BakeData& bake, double toleranceDeg) {
@@ -240,7 +287,7 @@ glm::vec4 queryChart(const BakeData& bake, glm::vec3 p, glm::vec3 omega) {
     std::vector<glm::vec4> values(L.sampleCount(), glm::vec4(0.0f));
     auto need = [&](int i) {
         if (values[i] == glm::vec4(0.0f))
-            values[i] = decompressSample(bake, i, localViewDirection(L, i, omega));
+            values[i] = foldedSample(bake, i, localViewDirection(L, i, omega));
     };
     std::vector<char> inWindow(size_t(W) * L.muHeight, 0);
     for (int y = std::max(0, c.y - reach); y <= std::min(L.muHeight - 1, c.y + reach); ++y)
@@ -315,7 +362,7 @@ std::vector<glm::vec4> queryBake(const BakeData& bake, const std::vector<glm::ve
         for (int j = 0; j <= r; ++j)
             for (int i = 0; i + j <= r; ++i) {
                 uint32_t s = L.sampleAt(bestT, i, j);
-                values[s] = decompressSample(bake, static_cast<int>(s), localViewDirection(L, s, omega));
+                values[s] = foldedSample(bake, static_cast<int>(s), localViewDirection(L, s, omega));
             }
         glm::vec4 d = interpolateRho(L, values.data(), bestT, bestUV.x, bestUV.y);
         glm::vec3 e(d);

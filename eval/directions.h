@@ -22,7 +22,10 @@ Scene sceneOfBake(const BakeData& bake, const std::string& bakePath, const std::
 // Random (sample, omega) pairs, omega uniform over the outer hemisphere (so almost surely
 // between grid directions), decompressed against a fresh trace of the same path. Angular error
 // in degrees: mean, median, p95, p99, max; path-length error; the shares of TIR, capped and
-// re-entering paths, each with its own error. `order` < 0: all stored bands. cos(theta) of omega
+// re-entering paths, each with its own error. `order` < 0: all stored bands. "prediction": how
+// well the bake's error model (predictedError) ranks the measured angles (Spearman, and the median
+// measured error in each decile of the prediction), beside the old proxy, 1 - the resultant
+// length |D.xyz| of the reconstruction. cos(theta) of omega
 // is drawn uniformly in [zMin, zMax): [0, 0.1) probes grazing entry alone.
 // `sampleOrder`, if given, is the order used at each sample (per-sample adaptive order).
 nlohmann::json evaluateDirections(const BakeData& bake, const Scene& scene, size_t pairs,
@@ -52,6 +55,9 @@ struct QueryRefused : InputError {
 constexpr float kQueryDistance = 1e-3f;
 std::vector<glm::vec4> queryBake(const BakeData& bake, const std::vector<glm::vec3>& p,
                                  const std::vector<glm::vec3>& w, float maxDistance = -1.0f);
+
+// Spearman's rank correlation of a and b (ties take their mean rank); 0 when either is constant.
+double spearman(const std::vector<double>& a, const std::vector<double>& b);
 
 // Summary statistics of a list of errors: mean, median, p95, p99, max, count.
 nlohmann::json errorStats(std::vector<double> e);

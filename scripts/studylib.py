@@ -3,6 +3,7 @@ bakes made once into a work folder and reused by every study, renders and their 
 Python standard library only.
 """
 import glob
+import hashlib
 import json
 import math
 import os
@@ -87,12 +88,24 @@ class Tools:
             return json.load(open(os.path.join(ROOT, scene)))["parts"][0]["ior"]
         return 1.5
 
+    def bake_key(self, scene, options, ior):
+        """What a bake is made of: the scene file's bytes, the options given, and every default
+        the bake tool would fill in (its --help lists them), so that a changed default never
+        reuses a stale bake."""
+        if not hasattr(self, "_bake_defaults"):
+            self._bake_defaults = self.run([self.exe["bake"], "--help"])
+        h = hashlib.sha256()
+        with open(os.path.join(ROOT, scene), "rb") as f:
+            h.update(f.read())
+        h.update(json.dumps([scene, list(options), ior, self._bake_defaults]).encode())
+        return h.hexdigest()[:10]
+
     def bake(self, name, scene, options, ior=None):
-        """Bakes `scene` (relative to the repository) unless the work folder has it. `ior`
-        replaces the index: --ior for a mesh, every part's for a JSON scene."""
+        """Bakes `scene` (relative to the repository) unless the work folder has it, keyed by
+        bake_key. `ior` replaces the index: --ior for a mesh, every part's for a JSON scene."""
         if ior is not None and abs(ior - self.own_ior(scene)) < 1e-9:
             ior = None  # the scene's own index: the plain bake, shared with other studies
-        tag = name if ior is None else "%s_ior%g" % (name, ior)
+        tag = (name if ior is None else "%s_ior%g" % (name, ior)) + "-" + self.bake_key(scene, options, ior)
         out = os.path.join(self.work, "bakes", tag + ".shrefract.exr")
         meta = out + ".json"
         self.wait_for_other_baker(out)
@@ -119,16 +132,28 @@ class Tools:
             self.log("baked %s in %.0f s" % (tag, seconds))
         return out
 
-    def render(self, bake, tag, camera, env="courtyard", method="sh", extra=(), size=None):
-        """Renders one evaluation buffer; returns its path, ms per frame and GPU memory (MB)."""
+    def render(self, bake, tag, camera, env="courtyard", method="sh", extra=(), size=None, reuse=False,
+               spp=None):
+        """Renders one evaluation buffer; returns its path, ms per frame and GPU memory (MB).
+        `env`: a name in data/envmaps or a path. `reuse`: keep a render (and its log) that the
+        work folder already has, e.g. a reference, whose tag must then name all it depends on.
+        `spp`: the ray tracer's samples per pixel (default: --spp)."""
         size = size or self.args.size
+        spp = self.args.spp if spp is None else spp
         out = os.path.join(self.work, "renders", tag + ".exr")
-        text = self.run([self.exe["render"], bake, "--env",
-                         os.path.join(ROOT, "data", "envmaps", env + ".exr"), "--camera",
-                         "orbit:" + camera, "--size", "%dx%d" % (size, size), "--method", method,
-                         "--backend", self.args.backend, "--frames", str(self.args.frames),
-                         "--dirs", out] + list(extra) +
-                        (["--spp", str(self.args.spp)] if method == "raytrace" and self.args.spp > 1 else []))
+        log = out + ".log"
+        if reuse and os.path.exists(out) and os.path.exists(log):
+            text = open(log).read()
+        else:
+            envPath = env if os.path.sep in env else os.path.join(ROOT, "data", "envmaps", env + ".exr")
+            text = self.run([self.exe["render"], bake, "--env", envPath, "--camera",
+                             camera if camera.startswith("orbit:") else "orbit:" + camera,
+                             "--size", "%dx%d" % (size, size), "--method", method,
+                             "--backend", self.args.backend, "--frames", str(self.args.frames),
+                             "--dirs", out] + list(extra) +
+                            (["--spp", str(spp)] if method == "raytrace" and spp > 1 else []))
+            with open(log, "w") as f:
+                f.write(text)
         ms = re.search(r"ms per frame \(\w+\): ([0-9.]+)", text)
         mb = re.search(r"GPU memory: ([0-9.]+) MB(?: \+ bracketing bake ([0-9.]+) MB)?", text)
         memory = None
@@ -143,9 +168,11 @@ class Tools:
         with open(report) as f:
             return json.load(f)
 
-    def montage(self, inputs, labels, png, errors=False):
+    def montage(self, inputs, labels, png, errors=False, flip=False):
+        """Labelled tiles; rows of angle heat maps (`errors`) and FLIP maps (`flip`) against the
+        first input."""
         self.run([self.exe["eval"], "montage"] + list(inputs) + ["--labels"] + list(labels) +
-                 (["--errors"] if errors else []) + ["--out", png])
+                 (["--errors"] if errors else []) + (["--flip"] if flip else []) + ["--out", png])
 
 
 def summary(r):

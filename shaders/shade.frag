@@ -7,7 +7,9 @@
 //
 // Spread shading (uSpread, docs/runtime.md): where the SH reconstruction is shorter than a unit
 // vector the mapping scatters, and the lookup averages the environment over a vMF lobe of the
-// width whose mean resultant length that is, widened by the pixel's screen-space footprint.
+// width whose mean resultant length that is, widened by the pixel's screen-space footprint. With
+// the bake's error model the length carries its predicted error (shaders/error_fold.frag). Blend
+// shading (uBlendSigma > 0) mixes that lobe with the sharp lookup.
 #include "shading.glsl"
 #ifdef SHREFRACT_DIRECT
 in vec4 vD;
@@ -23,8 +25,14 @@ uniform bool uToneMap;
 uniform float uExposure;
 uniform bool uSpread;
 uniform float uSpreadScale;     // lobe width factor on spreadSigma()
+uniform float uBlendSigma;      // > 0 (blend shading): the sharp lookup and the lobe mixed, the
+                                // lobe's share spread / (spread + uBlendSigma)
+uniform float uJitterCell;      // > 0 (jitter shading): one direction drawn within the lobe per
+                                // cell of this size (object units), instead of the lobe's mean;
+                                // oDirection keeps the bake's exit (what the metrics measure)
 uniform float uFootprintScale;  // factor on the screen-space turn of a direction per pixel
 in vec3 vPosition;
+in vec3 vObjectPosition;
 in vec3 vNormal;
 layout(location = 0) out vec4 oColor;
 layout(location = 1) out vec4 oDirection;
@@ -40,14 +48,21 @@ void main() {
     // A (near) zero interpolated direction has no direction: go straight through, never NaN.
     float resultant = length(r.xyz);
     vec3 exitWorld = resultant > 1e-10 ? normalize(uModelRotation * (r.xyz / resultant)) : -v;
-    float exitSigma = 0.0, reflectSigma = 0.0;
+    vec4 lookup = vec4(exitWorld, 0.0);
+    float reflectSigma = 0.0, spread = 0.0;
     if (uSpread) {
-        float spread = spreadSigma(resultant, uSpreadScale);
-        float footprint = footprintSigma(exitWorld, uFootprintScale);
-        exitSigma = sqrt(spread * spread + footprint * footprint);
+        spread = spreadSigma(resultant, uSpreadScale);
+        lookup = transmissionLookup(exitWorld, spread, uFootprintScale, uJitterCell, vObjectPosition);
         reflectSigma = footprintSigma(reflect(-v, n), uFootprintScale);
     }
-    vec3 c = shadeGlass(exitWorld, exitSigma, r.w, n, v, uEta, uKappa, reflectSigma);
+    vec3 c = shadeGlass(lookup.xyz, lookup.w, r.w, n, v, uEta, uKappa, reflectSigma);
+    if (uSpread && uBlendSigma > 0.0) {
+        // Keep the sharp lookup's contrast where the lobe is narrow, and most of it where it is
+        // not: the mean of a wide lobe is a grey the truth never shows.
+        float sharpSigma = footprintSigma(exitWorld, uFootprintScale);
+        vec3 sharp = shadeGlass(exitWorld, sharpSigma, r.w, n, v, uEta, uKappa, reflectSigma);
+        c = mix(sharp, c, spread / (spread + uBlendSigma));
+    }
     oColor = vec4(uToneMap ? toneMap(c, uExposure) : c, 1.0);
     oDirection = vec4(exitWorld, 1.0);
 }

@@ -8,11 +8,13 @@ uniform mat4 uModel;
 uniform mat4 uViewProjection;
 uniform mat3 uNormalMatrix;
 out vec3 vPosition;
+out vec3 vObjectPosition;  // where on the object: a seed that moves with it (jitter shading)
 out vec3 vNormal;
 out vec2 vUV;
 void main() {
     vec4 p = uModel * vec4(aPosition, 1.0);
     vPosition = p.xyz;
+    vObjectPosition = aPosition;
     vNormal = uNormalMatrix * aNormal;
     vUV = aUV;
     gl_Position = uViewProjection * p;

@@ -24,6 +24,7 @@ uniform sampler2D uDB;  // shade_ior.frag's second bake (runtime/src/ior.h), sam
 out vec4 vDB;
 #endif
 out vec3 vPosition;
+out vec3 vObjectPosition;  // where on the object: a seed that moves with it (jitter shading)
 out vec3 vNormal;
 out vec4 vD;
 
@@ -41,6 +42,7 @@ void main() {
 #endif
     vec4 world = uModel * vec4(P, 1.0);
     vPosition = world.xyz;
+    vObjectPosition = P;
     vNormal = uNormalMatrix * N;
     gl_Position = uViewProjection * world;
 }

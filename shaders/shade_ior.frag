@@ -29,7 +29,9 @@ uniform float uExposure;
 uniform bool uSpread;
 uniform float uSpreadScale;
 uniform float uFootprintScale;
+uniform float uJitterCell;  // as shade.frag's (blend shading is shaded as spread here)
 in vec3 vPosition;
+in vec3 vObjectPosition;
 in vec3 vNormal;
 layout(location = 0) out vec4 oColor;
 layout(location = 1) out vec4 oDirection;
@@ -73,13 +75,11 @@ void main() {
     vec3 c, exitG;
     for (int k = 0; k < 3; ++k) {
         vec3 e = blendDirections(a, b, uBlend[k]);
-        float sigma = 0.0;
-        if (uSpread) {
-            float spread = spreadSigma(mix(resA, resB, uBlend[k]), uSpreadScale);
-            float footprint = footprintSigma(e, uFootprintScale);
-            sigma = sqrt(spread * spread + footprint * footprint);
-        }
-        c[k] = shadeGlass(e, sigma, mix(lenA, lenB, uBlend[k]), n, v, uEtaRGB[k], uKappa,
+        vec4 lookup = vec4(e, 0.0);
+        if (uSpread)
+            lookup = transmissionLookup(e, spreadSigma(mix(resA, resB, uBlend[k]), uSpreadScale),
+                                        uFootprintScale, uJitterCell, vObjectPosition);
+        c[k] = shadeGlass(lookup.xyz, lookup.w, mix(lenA, lenB, uBlend[k]), n, v, uEtaRGB[k], uKappa,
                           reflectSigma)[k];
         if (k == 1) exitG = e;
     }

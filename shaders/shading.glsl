@@ -37,6 +37,41 @@ float footprintSigma(vec3 d, float scale) {
     return scale * max(length(dFdx(d)), length(dFdy(d)));
 }
 
+// A direction drawn from the lobe of width sigma (radians) around the unit d: a 2D Gaussian
+// offset in d's tangent plane, its two numbers hashed from the integer cell (PCG-style integer
+// hash; the same cell gives the same direction in every frame).
+uvec3 pcg3(uvec3 v) {
+    v = v * 1664525u + 1013904223u;
+    v.x += v.y * v.z; v.y += v.z * v.x; v.z += v.x * v.y;
+    v ^= v >> 16u;
+    v.x += v.y * v.z; v.y += v.z * v.x; v.z += v.x * v.y;
+    return v;
+}
+vec3 lobeDirection(vec3 d, float sigma, vec3 cell) {
+    if (sigma <= 0.0) return d;
+    vec3 h = vec3(pcg3(uvec3(ivec3(cell)))) / 4294967296.0;
+    float radius = sigma * sqrt(-2.0 * log(max(h.x, 1e-7)));
+    float angle = 6.28318531 * h.y;
+    vec3 t = normalize(abs(d.z) < 0.9 ? cross(d, vec3(0, 0, 1)) : cross(d, vec3(1, 0, 0)));
+    vec3 b = cross(d, t);
+    return normalize(d + radius * (cos(angle) * t + sin(angle) * b));
+}
+
+// Where the transmitted light is looked up (docs/runtime.md "Shading where the bake is unsure"):
+// the exit e and the lobe the bake leaves around it, `spread` radians wide. Jitter (jitterCell >
+// 0): one direction drawn from the lobe, seeded by the object-space cell of objectPosition, looked
+// up over the pixel's footprint; otherwise the lobe's mean, the lobe widened by the footprint in
+// quadrature. .xyz the direction, .w the width of its lookup.
+vec4 transmissionLookup(vec3 e, float spread, float footprintScale, float jitterCell,
+                        vec3 objectPosition) {
+    if (jitterCell > 0.0) {
+        vec3 d = lobeDirection(e, spread, floor(objectPosition / jitterCell));
+        return vec4(d, footprintSigma(d, footprintScale));
+    }
+    float footprint = footprintSigma(e, footprintScale);
+    return vec4(e, sqrt(spread * spread + footprint * footprint));
+}
+
 // common/optics.h FresnelDielectric: unpolarized, eta = n_t / n_i, 1 on TIR.
 float fresnelDielectric(float cosI, float eta) {
     cosI = clamp(cosI, 0.0, 1.0);

@@ -86,6 +86,20 @@ int main(int argc, char** argv) {
                                  {"target", 1.3},
                                  {"note", std::string(ToString(opt.fit)) + " over projection, same run"}};
             }
+            if (!noFitRatio && opt.errorOrder >= 0) {
+                // The error model's cost (docs/bake.md "Error model"): the same bake without it.
+                BakeOptions n = opt;
+                n.errorOrder = -1;
+                c = cpuSeconds();
+                const BakeStats ns = bake(scene, n, input).stats;
+                const double cpuNone = cpuSeconds() - c;
+                fits["errorModel"] = {{"order", opt.errorOrder},
+                                      {"withoutSeconds", ns.wallSeconds},
+                                      {"withoutCpuSeconds", cpuNone},
+                                      {"ratio", {{"wall", res.stats.wallSeconds / ns.wallSeconds},
+                                                 {"cpu", cpuDefault / cpuNone}}},
+                                      {"note", "the default bake over the same without an error model, same run"}};
+            }
         }
         const BakeStats& st = res.stats;
         rusage ru;

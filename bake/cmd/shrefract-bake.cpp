@@ -77,6 +77,10 @@ int main(int argc, char** argv) {
     app.add_option("--fit-weighting", weighting,
                    "--fit weighted: FLAGGED:DEG:DISAGREEING:TRIMDEG:TRIMMED:PASSES (bake/fit.h)")
         ->capture_default_str();
+    app.add_option("--error-order", opt.errorOrder,
+                   "SH order of the stored error model, the fit's angular error over the view "
+                   "directions (docs/bake.md \"Error model\"; -1: none)")
+        ->capture_default_str()->check(CLI::Range(-1, limits::kMaxErrorOrder));
     app.add_option("--precision", precision, "weight storage: f32, f16 or u8")->capture_default_str()
         ->check(CLI::IsMember({"f32", "f16", "u8"}));
     app.add_option("--threads", opt.threads, "worker threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
@@ -251,7 +255,7 @@ int main(int argc, char** argv) {
             if (nCheckpoints <= 1) {
                 SliceResult all = plan.bakeSlice(0, plan.batchCount());
                 res.stats = all.stats;
-                res.data = plan.data(std::move(all.weights), res.stats);
+                res.data = plan.data(std::move(all.weights), std::move(all.errors), res.stats);
             } else {
                 CheckpointOptions co;
                 co.workDir = workDir;

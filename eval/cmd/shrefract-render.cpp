@@ -101,8 +101,16 @@ int main(int argc, char** argv) {
     app.add_option("--decompression", sh.decompression, "sh, direct path: vertex | texture | auto")
         ->capture_default_str()->check(CLI::IsMember({"vertex", "texture", "auto"}));
     app.add_option("--shading", sh.shading,
-                   "sh: spread (lobes from the SH length and the pixel footprint) | sharp (the paper's lookup)")
-        ->capture_default_str()->check(CLI::IsMember({"spread", "sharp"}));
+                   "sh: spread (lobes from the predicted error, or the SH length, and the pixel "
+                   "footprint) | sharp (the paper's lookup) | blend (the two mixed by the lobe's width) | jitter (one stable direction drawn from the lobe)")
+        ->capture_default_str()->check(CLI::IsMember({"spread", "sharp", "blend", "jitter"}));
+    app.add_option("--jitter-cell", sh.jitterCell, "sh, jitter shading: the cell of one drawn direction, a fraction of the object's bounding-box diagonal")
+        ->capture_default_str()->check(CLI::Range(1e-6f, 10.0f));
+    app.add_option("--blend-sigma", sh.blendSigma, "sh, blend shading: lobe width (radians) at which the lobe has half the weight")
+        ->capture_default_str()->check(CLI::Range(1e-4f, 10.0f));
+    bool noErrorModel = false;
+    app.add_flag("--no-error-model", noErrorModel,
+                 "sh: lobe widths from the SH length alone, not from the bake's error model");
     app.add_option("--spread-scale", sh.spreadScale, "sh, spread shading: lobe width factor")
         ->capture_default_str()->check(CLI::Range(0.0f, 100.0f));
     app.add_option("--footprint-scale", sh.footprintScale, "sh, spread shading: screen footprint factor")
@@ -320,6 +328,7 @@ int main(int argc, char** argv) {
             env = std::make_unique<Environment>(Environment::loadLatLong(envPath));
             if (method == "sh") {
                 RefractorOptions options = sh;
+                options.errorModel = !noErrorModel;
                 options.preset = preset;
                 options.form = form;
                 options.order = order;

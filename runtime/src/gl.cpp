@@ -95,4 +95,19 @@ void checkGlError(const char* file, int line) {
 }
 #endif
 
+void Target::create(int w, int h, GLenum filter) {
+    texture = makeTexture2D(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT, nullptr, filter);
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture, 0);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        throw std::runtime_error("shrefract: RGBA32F render target incomplete");
+}
+
+void Target::destroy() {
+    if (fbo) glDeleteFramebuffers(1, &fbo);
+    if (texture) glDeleteTextures(1, &texture);
+    fbo = texture = 0;
+}
+
 }  // namespace shrefract::gl

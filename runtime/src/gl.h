@@ -110,6 +110,14 @@ GLuint buildProgram(const std::string& vertex, const std::string& fragment, cons
 GLuint makeTexture2D(GLenum internal, int w, int h, GLenum format, GLenum type, const void* data,
                      GLenum filter);
 
+// An RGBA32F texture and the framebuffer that renders into it (the runtime's passes' targets).
+struct Target {
+    GLuint texture = 0, fbo = 0;
+    // Throws std::runtime_error if the framebuffer is incomplete. Leaves it bound.
+    void create(int w, int h, GLenum filter);
+    void destroy();
+};
+
 // GL error check that compiles out of release builds (STYLE.md).
 #ifdef NDEBUG
 #define SHREFRACT_GL_CHECK() ((void)0)

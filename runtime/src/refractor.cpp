@@ -22,6 +22,7 @@
 #include "common/error.h"
 #include "common/sh.h"
 #include "environment_gl.h"
+#include "error_fold.h"
 #include "gl.h"
 #include "ior.h"
 #include "shadergen.h"
@@ -35,23 +36,6 @@ using namespace gl;
 namespace {
 
 // A float render target with its own framebuffer.
-struct Target {
-    GLuint texture = 0, fbo = 0;
-    void create(int w, int h, GLenum filter) {
-        texture = makeTexture2D(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT, nullptr, filter);
-        glGenFramebuffers(1, &fbo);
-        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture, 0);
-        if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-            throw std::runtime_error("shrefract: RGBA32F render target incomplete");
-    }
-    void destroy() {
-        if (fbo) glDeleteFramebuffers(1, &fbo);
-        if (texture) glDeleteTextures(1, &texture);
-        fbo = texture = 0;
-    }
-};
-
 // Padded copy of per-sample vec3s into a mu-sized RGB float image.
 std::vector<float> muImage3(const std::vector<glm::vec3>& v, int w, int h) {
     std::vector<float> out(static_cast<size_t>(w) * h * 3, 0.0f);
@@ -94,6 +78,7 @@ struct Refractor::Impl {
         return vertexShAllowed && !smoothing && (vertexShRequired || order <= kAutoVertexMaxOrder);
     }
     int muW = 0, muH = 0, rhoW = 0, rhoH = 0, listWidth = 1;
+    float diagonal = 1.0f;  // of the samples' bounding box, object units (the jitter cell's unit)
     ShaderLimits limits;
     ShForm form = ShForm::Auto;
     WeightFormat weightFormat = WeightFormat::Float32;
@@ -119,6 +104,9 @@ struct Refractor::Impl {
     glm::vec3 lastEye{0, 0, 3};  // object space, of the last update()
     // Chart bakes: the isolated-surface pipeline, whose refraction map (the atlas) is `rho`.
     std::unique_ptr<ChartPipeline> charts;
+    // The bake's error model folded into D_mu's length (runtime/src/error_fold.h), when it has one
+    // and RefractorOptions::errorModel is on; texture-space decompression only.
+    std::unique_ptr<ErrorFold> errorFold;
     IorShading ior;              // setIor(): shading at other indices (runtime/src/ior.h)
 
     void use() const { ensureLoaded(loader); }
@@ -242,15 +230,19 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
     m->correction = options.correction;
     m->muW = L.muWidth;
     m->muH = L.muHeight;
+    glm::vec3 lo(L.position[0]), hi(L.position[0]);
+    for (const glm::vec3& p : L.position) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    m->diagonal = std::max(glm::length(hi - lo), 1e-6f);
     m->rhoW = L.rhoWidth;
     m->rhoH = L.rhoHeight;
     GLint units = 16;
     glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &units);
     m->limits = shaderPreset(options.preset, units);
     m->form = parseShForm(options.form);
-    if (options.shading != "spread" && options.shading != "sharp")
-        throw std::invalid_argument("shrefract: shading \"" + options.shading + "\" (spread | sharp)");
-    m->spread = options.shading == "spread";
+    if (options.shading != "spread" && options.shading != "sharp" && options.shading != "blend" &&
+        options.shading != "jitter")
+        throw std::invalid_argument("shrefract: shading \"" + options.shading + "\" (spread | sharp | blend | jitter)");
+    m->spread = options.shading != "sharp";
 
     // Which path, and where the SH are evaluated on the direct one. Chart bakes have their own.
     const bool charts = L.isChartLayout();
@@ -355,6 +347,10 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
             glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, k, m->muW, m->muH, 1, GL_RGBA, type, data);
         else
             m->weightTex.push_back(makeTexture2D(internal, m->muW, m->muH, GL_RGBA, type, data, GL_NEAREST));
+    }
+    if (d.errorOrder >= 0 && options.errorModel) {
+        m->errorFold = std::make_unique<ErrorFold>(d, texelOf);
+        m->memory.weights += m->errorFold->bytes();
     }
     // Neighbour lists (CSR) for smoothing.
     if (!L.neighbourIndex.empty() && L.neighbourOffset.size() == static_cast<size_t>(n)) {
@@ -530,6 +526,7 @@ Refractor::~Refractor() {
         if (b) glDeleteBuffers(1, &b);
     glDeleteQueries(kStages, m.queries);
     m.charts.reset();
+    m.errorFold.reset();
 }
 
 void Refractor::Impl::decompressInTextureSpace(bool timed) {
@@ -610,6 +607,13 @@ void Refractor::Impl::decompressInTextureSpace(bool timed) {
     end(kDecompress, &timings.decompress);
     if (timed) timings.passes = static_cast<int>(c.programs.size());
     lastD = sum[(c.programs.size() + 1) % 2].texture;
+    if (errorFold)
+        lastD = errorFold->apply(lastD, localView.texture, [&] {
+            if (charts)
+                charts->drawFootprint();
+            else
+                glDrawArrays(GL_TRIANGLES, 0, 3);
+        });
 
     // Optional spatial smoothing through the neighbour lists.
     if (timed) timings.smooth = 0;
@@ -734,6 +738,8 @@ void Refractor::draw(const glm::mat4& view, const glm::mat4& projection, const g
     setFloat(p, "uExposure", m.options.exposure);
     setInt(p, "uSpread", m.spread ? 1 : 0);
     setFloat(p, "uSpreadScale", m.options.spreadScale);
+    setFloat(p, "uBlendSigma", m.options.shading == "blend" ? m.options.blendSigma : 0.0f);
+    setFloat(p, "uJitterCell", m.options.shading == "jitter" ? m.options.jitterCell * m.diagonal : 0.0f);
     setFloat(p, "uFootprintScale", m.options.footprintScale);
     useEnvironment(p, environment, 0);
     if (m.ior.active)

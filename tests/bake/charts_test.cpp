@@ -236,12 +236,14 @@ TEST_P(ChartLayout, DistortionStaysWithinTheStatedBound) {
     }
 }
 
-// Charts of an isolated atlas keep the gutter free: covered texels of two different charts are
-// more than 2 x gutter texels apart (Chebyshev), so each chart can grow `gutter` texels.
+// Charts keep the gutter free: covered texels of two different charts are more than 2 x gutter
+// texels apart (Chebyshev), so each chart can grow `gutter` texels. Isolated atlases are packed so;
+// a uv atlas keeps the artist's spacing, which the bake neither moves nor checks, so for vase_uv
+// this says that the test asset's own UVs leave room for the runtime's default dilation. (It
+// used to be skipped for uv as "the artist's spacing"; it passes, so it runs.)
 TEST_P(ChartLayout, ChartsKeepTheirGutters) {
     const Built& b = built(GetParam());
     const SurfaceLayout& L = b.layout;
-    if (GetParam().kind != LayoutKind::Isolated) GTEST_SKIP() << "uv: the artist's spacing";
     const int G = L.atlas.gutter;
     ASSERT_EQ(G, 2);
     const std::vector<int> chart = chartOfTexels(L);

@@ -1,5 +1,5 @@
-// What "the same bake" means for shards, checkpoints and schedulers: the same weights bit for
-// bit and the same manifest but for its one timing field, stats.seconds.
+// What "the same bake" means for shards, checkpoints and schedulers: the same weights and error
+// model bit for bit and the same manifest but for its one timing field, stats.seconds.
 #pragma once
 
 #include <cstdio>
@@ -23,6 +23,10 @@ inline std::string bakeDifference(const BakeData& a, const BakeData& b) {
             return text;
         }
     }
+    if (a.errorOrder != b.errorOrder || a.errors.size() != b.errors.size())
+        return "error models differ: order " + std::to_string(a.errorOrder) + " vs " + std::to_string(b.errorOrder);
+    if (!a.errors.empty() && std::memcmp(a.errors.data(), b.errors.data(), a.errors.size() * sizeof(float)) != 0)
+        return "error model values differ";
     nlohmann::json x = a.manifest, y = b.manifest;
     if (x.contains("stats")) x["stats"].erase("seconds");
     if (y.contains("stats")) y["stats"].erase("seconds");

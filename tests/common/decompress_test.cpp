@@ -2,6 +2,7 @@
 // sources, bilinear lookup and the seam jump, on tiny atlases whose answers are worked out by
 // hand.
 #include "common/decompress.h"
+#include "common/sh.h"
 
 #include <gtest/gtest.h>
 
@@ -123,6 +124,28 @@ TEST(ChartMap, SeamJumpIsTheAngleAcrossTheCut) {
     // A crease (the normals differ across the edge) is no smooth seam.
     A.vertexNormal[3] = A.vertexNormal[4] = glm::vec3(0, 1, 0);
     EXPECT_TRUE(smoothSeams(L).empty());
+}
+
+// predictedError evaluates the error model's SH, undoes its logarithm and clamps at 0. Sample 1:
+// ln(err + 0.01) = ln 0.21 + y_2^0(w), y_2^0 = sqrt(5 / (16 pi)) (3 z^2 - 1); sample 0: a
+// constant below ln 0.01, so no error anywhere.
+TEST(Decompress, PredictedErrorIsTheModelClampedAtZero) {
+    BakeData d;
+    d.layout.position = {{0, 0, 0}, {1, 0, 0}};
+    d.errorOrder = 2;
+    d.errors.assign(size_t(shEvenCount(2)) * 2, 0.0f);
+    const float root4pi = std::sqrt(4.0f * float(M_PI));
+    d.errors[0] = std::log(0.005f) * root4pi;      // sample 0, band 0
+    d.errors[1] = std::log(0.21f) * root4pi;       // sample 1, band 0
+    d.errors[size_t(shEvenIndex(2, 0)) * 2 + 1] = 1.0f;
+    const float c = std::sqrt(5.0f / (16.0f * float(M_PI)));
+    EXPECT_NEAR(predictedError(d, 1, {0, 0, 1}), 0.21f * std::exp(2 * c) - 0.01f, 1e-5f);
+    EXPECT_NEAR(predictedError(d, 1, glm::normalize(glm::vec3(1, 0, 1))), 0.21f * std::exp(0.5f * c) - 0.01f, 1e-5f);
+    EXPECT_NEAR(predictedError(d, 1, {1, 0, 0}), 0.21f * std::exp(-c) - 0.01f, 1e-5f);
+    EXPECT_EQ(predictedError(d, 0, {0, 0, 1}), 0.0f);
+    d.errorOrder = -1;
+    d.errors.clear();
+    EXPECT_EQ(predictedError(d, 1, {0, 0, 1}), -1.0f);  // no model
 }
 
 }  // namespace

@@ -363,6 +363,46 @@ TEST(Format, RoundTripF32IsExact) {
     EXPECT_TRUE(leftovers(path.parent_path()).empty());
 }
 
+// Version 3's error model (docs/format.md "error"): stored as float, whatever the weights'
+// precision, bit for bit; its manifest says what it holds.
+TEST(Format, ErrorModelRoundTripsExactly) {
+    for (Precision p : {Precision::F32, Precision::U8}) {
+        const fs::path path = scratch() / (std::string(ToString(p)) + ".shrefract.exr");
+        BakeData d = syntheticBake(p);
+        d.errorOrder = 2;
+        std::mt19937 rng(3);
+        std::uniform_real_distribution<float> u(-0.5f, 1.5f);
+        d.errors.resize(size_t(shEvenCount(2)) * d.layout.sampleCount());
+        for (float& e : d.errors) e = u(rng);
+        writeBake(path.string(), d);
+        const BakeData r = readBake(path.string());
+        EXPECT_EQ(r.manifest["version"], kFormatVersion);
+        EXPECT_EQ(r.manifest["errorModel"]["order"], 2);
+        EXPECT_EQ(r.manifest["errorModel"]["unit"], "radians");
+        ASSERT_EQ(r.errorOrder, 2);
+        ASSERT_EQ(r.errors, d.errors) << ToString(p);
+    }
+}
+
+TEST(Format, NoErrorModelReadsAsNone) {
+    const fs::path path = scratch() / "none.shrefract.exr";
+    writeBake(path.string(), syntheticBake(Precision::F32));
+    const BakeData r = readBake(path.string());
+    EXPECT_EQ(r.errorOrder, -1);
+    EXPECT_TRUE(r.errors.empty());
+    EXPECT_FALSE(r.manifest.contains("errorModel"));
+}
+
+TEST(Format, ErrorModelOfTheWrongSizeIsRefusedBeforeWriting) {
+    const fs::path path = scratch() / "bad.shrefract.exr";
+    BakeData d = syntheticBake(Precision::F32);
+    d.errorOrder = 2;
+    d.errors.assign(5, 0.0f);
+    EXPECT_THROW(writeBake(path.string(), d), std::invalid_argument);
+    EXPECT_FALSE(fs::exists(path));
+    EXPECT_TRUE(leftovers(path.parent_path()).empty());
+}
+
 TEST(Format, RoundTripF16WithinHalfPrecision) {
     const fs::path path = scratch() / "f16.shrefract.exr";
     const BakeData d = syntheticBake(Precision::F16);

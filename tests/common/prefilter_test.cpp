@@ -165,5 +165,20 @@ TEST(Prefilter, CubeLookupsAreSeamless) {
     EXPECT_LT(worst, 0.05f);
 }
 
+// The length that carries a predicted error (resultantOfSigma) against the closed form of the
+// vMF mean resultant length, and spreadSigma reading the width back from it.
+TEST(Prefilter, ResultantOfSigmaIsTheVmfMeanLength) {
+    EXPECT_FLOAT_EQ(resultantOfSigma(0.0f), 1.0f);
+    // sigma 1: kappa 1, coth(1) - 1 = 0.31303528.
+    EXPECT_NEAR(resultantOfSigma(1.0f), 0.31303528f, 1e-6f);
+    // sigma 0.1: kappa 100, coth(100) = 1 to double precision: 1 - 0.01.
+    EXPECT_NEAR(resultantOfSigma(0.1f), 0.99f, 1e-6f);
+    for (float s : {0.01f, 0.05f, 0.2f, 0.5f, 1.0f}) {
+        // Banerjee's kappa(R) is within 3 % of the exact inverse over this range (measured: 2.3 %
+        // at sigma 1, < 0.1 % below 0.2); a lobe read back 10 % off fails.
+        EXPECT_NEAR(spreadSigma(resultantOfSigma(s)), s, 0.03f * s) << s;
+    }
+}
+
 }  // namespace
 }  // namespace shrefract

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <string>
 
+#include "common/bakefile.h"
 #include "support/cli_run.h"
 
 namespace {
@@ -90,7 +91,7 @@ TEST(EvalCli, EveryToolSharesTheExitCodes) {
         CommandResult v = run(exe + " --version");
         EXPECT_EQ(v.code, 0) << v.out;
         EXPECT_EQ(v.out.find(name + " "), 0u) << v.out;
-        EXPECT_NE(v.out.find("(bake format 2)"), std::string::npos) << v.out;
+        EXPECT_NE(v.out.find("(bake format " + std::to_string(shrefract::kFormatVersion) + ")"), std::string::npos) << v.out;
         EXPECT_EQ(run(exe + " --help").code, 0) << name;
         CommandResult u = run(exe + " --no-such-option");
         EXPECT_EQ(u.code, 2) << name << ": " << u.out;

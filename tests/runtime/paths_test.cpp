@@ -246,6 +246,7 @@ TEST_P(Paths, SpreadLookupMatchesItsCpuTwin) {
             for (int c = 0; c < 3; ++c) data.weights[i * 4 + c] = R * e[c] / y00;
         RefractorOptions o;
         o.loader = context_->loader();
+        o.shading = "spread";
         o.footprintScale = 0.0f;
         auto r = Refractor::create(makeBake(data), o);
         const RenderedFrame f = renderFrame(*r, env, Camera::orbit(30, 20, 3.5f), 48, 48);

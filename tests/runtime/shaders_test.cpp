@@ -1,6 +1,9 @@
 // The GLSL files of shaders/ as the library embeds them (runtime/src/shaders.h).
 #include "shaders.h"
 
+#include "common/limits.h"
+#include "shadergen.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -61,7 +64,9 @@ TEST(ShaderFiles, EmbeddedAreTheFilesOnDiskWithIncludesResolved) {
 }
 
 // glslangValidator compiles every stage file as the GPU gets it (includes resolved). The
-// decompression template compiles through the generator (ShaderGen.GeneratedGlslCompiles).
+// decompression template compiles through the generator (ShaderGen.GeneratedGlslCompiles); the
+// error model's fold is compiled here with the pass runtime/src/error_fold.cpp generates for it
+// at the largest error order.
 TEST(ShaderFiles, EveryStageCompiles) {
     if (std::string(SHREFRACT_GLSLANG).empty() || !fs::exists(SHREFRACT_GLSLANG))
         GTEST_SKIP() << "glslangValidator not found (Debian: glslang-tools)";
@@ -72,7 +77,12 @@ TEST(ShaderFiles, EveryStageCompiles) {
         if (!endsWith(name, ".vert") && !endsWith(name, ".frag")) continue;
         if (name == "decompress.frag") continue;
         const fs::path f = dir / name;
-        std::ofstream(f, std::ios::binary) << shaders::source(name);
+        std::string text = shaders::source(name);
+        if (name == "error_fold.frag")
+            text = shaders::fill(text, "#pragma shrefract_generated",
+                                 generateDecompression(limits::kMaxErrorOrder, shaderPreset("modern"),
+                                                       ShForm::Polynomial).passes[0].generated);
+        std::ofstream(f, std::ios::binary) << text;
         const std::string cmd = std::string(SHREFRACT_GLSLANG) + " " + f.string() + " > " +
                                 f.string() + ".log 2>&1";
         EXPECT_EQ(std::system(cmd.c_str()), 0) << name << "\n" << readFile(f.string() + ".log");

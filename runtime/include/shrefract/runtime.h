@@ -139,12 +139,30 @@ struct RefractorOptions {
     bool halfWeights = false;
     bool smoothing = false;         // spatial smoothing through the bake's neighbour lists
     bool correction = true;         // interpolation-correction texels in rho (paper §5.3.1)
-    // "spread": where the SH reconstruction is short (the mapping scatters) the environment is
-    // averaged over a lobe of a prefiltered cube map, widened by the screen-space footprint;
-    // "sharp": the paper's single lookup along the exit direction (docs/runtime.md).
-    std::string shading = "spread";
-    float spreadScale = 0.5f;       // lobe width factor (spread shading; docs/runtime.md)
-    float footprintScale = 0.3f;    // screen-space footprint factor (spread shading)
+    // Where the bake is unsure of the exit (its error model predicts an error, or, without one,
+    // the SH reconstruction is short), a lobe spreadScale times that wide:
+    // "jitter" (the default): one direction drawn from the lobe, stable on the object, looked up
+    //   over the pixel's footprint: keeps the contrast the truth has;
+    // "spread": the environment averaged over the lobe (a prefiltered cube map), widened by the
+    //   footprint: the lobe's mean;
+    // "blend": the sharp lookup and the spread lobe mixed by the lobe's width;
+    // "sharp": the paper's single lookup along the exit direction.
+    // The defaults follow scripts/study-shading (object FLIP, detail ratio; docs/runtime.md).
+    std::string shading = "jitter";
+    float spreadScale = 0.15f;      // lobe width factor on the predicted error (docs/runtime.md)
+    float footprintScale = 0.15f;   // screen-space footprint factor
+    // "blend": the sharp lookup and the spread lobe mixed, the lobe's share sigma / (sigma +
+    // blendSigma) for a lobe sigma radians wide (docs/runtime.md "Blend shading").
+    float blendSigma = 0.1f;
+    // "jitter": one direction drawn from the spread lobe per cell of this size (a fraction of the
+    // object's bounding-box diagonal; about two pixels where the object spans 400), the same in
+    // every frame, instead of the lobe's mean (docs/runtime.md "Jitter shading").
+    float jitterCell = 0.005f;
+    // Spread shading takes the lobe width from the bake's error model, its predicted angular error
+    // at each sample and view direction, where the bake has one (format version 3; docs/runtime.md
+    // "Error model"); off, or on older bakes, from the SH reconstruction's length alone. Applies
+    // where D_mu is decompressed in texture space (not to vertex decompression).
+    bool errorModel = true;
     // Chart layouts (isolated, uv; paper §5.2): gutter rings filled around the charts by
     // dilation (-1: the bake's gutter; 0: none), and whether gutter texels next to a smooth seam
     // take the values across the cut instead (seam-aware filling, docs/runtime.md).

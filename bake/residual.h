@@ -1,0 +1,37 @@
+// The bake's model of its own error (docs/bake.md "Error model"). The fit sees the traced exit
+// r_j at every grid direction w_j; where the fitted SH miss it, the runtime should not pretend to
+// know the exit. Per sample the angle e_j between the fitted and the traced exit is projected onto
+// the even-parity SH through a low order E (solid-angle-weighted least squares, as
+// leastSquaresMatrix), so that the runtime can predict the angular error at any view direction
+// from (E+1)(E+2)/2 numbers: err(w) = sum_k e_k y_k(w), in radians, clamped at 0 where read.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "common/direction_grid.h"
+
+namespace shrefract {
+
+// The order of the error model a bake stores unless told otherwise: 15 numbers per sample beside
+// the 180 of order-8 weights (8 % more in f32), chosen by `shrefract-eval directions`' Spearman
+// correlation between predicted and measured error on bunny00: 0.59 at order 2, 0.70 at order 4
+// (docs/bake.md "Error model").
+constexpr int kDefaultErrorOrder = 4;
+
+// Build once per (grid, weight order, error order); use from many threads.
+class ResidualFitter {
+public:
+    ResidualFitter(const DirectionGrid& grid, int order, int errorOrder);
+    int errorCoefficients() const { return int(P_.rows()); }
+    // For B samples at once: R (J x 4B, sample s in columns 4s..4s+3: exit x, y, z, length) as
+    // traced and Wt (4B x K, sample s in rows 4s..4s+3) as fitted; writes E (Ke x B), the error
+    // model of sample s in column s.
+    void fit(const Eigen::Ref<const Eigen::MatrixXf>& R, const Eigen::Ref<const Eigen::MatrixXf>& Wt,
+             int B, Eigen::Ref<Eigen::MatrixXf> E) const;
+
+private:
+    Eigen::MatrixXf Y_;  // J x K: the stored functions through the weights' order at the grid
+    Eigen::MatrixXf P_;  // Ke x J: least-squares projection onto the error model's functions
+};
+
+}  // namespace shrefract

@@ -13,6 +13,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -199,11 +200,18 @@ TEST(Faults, SigtermAndSigintCancelABake) {
     const std::set<std::string> names = listing(out.parent_path());
     for (int sig : {SIGTERM, SIGINT}) {
         SCOPED_TRACE(strsignal(sig));
-        // A slower bake (rate 3, 32 x 64) so that the signal surely lands while it traces.
+        // A slower bake (rate 3, 32 x 64, ~5 s here) so that the signal lands while it traces,
+        // with progress on: its first line comes after the handlers are installed. A fixed delay
+        // raced the start on a loaded CI machine: SIGINT arrived before the handler, the default
+        // action killed the bake, and the exit status 128 + 2 looked like a clean cancel.
         std::vector<std::string> args = bakeArgs(out, "");
         args[5] = "3", args[9] = "32x64";
+        args.erase(std::find(args.begin(), args.end(), "-q"));
         const Child c = spawn(args, dir / "signal.log");
-        std::this_thread::sleep_for(std::chrono::milliseconds(300));
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+        while (readFile(dir / "signal.log").find("bake:") == std::string::npos &&
+               std::chrono::steady_clock::now() < deadline)
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
         ::kill(c.pid, sig);
         EXPECT_EQ(finish(c), 130) << readFile(dir / "signal.log");
         EXPECT_NE(readFile(dir / "signal.log").find("cancelled"), std::string::npos);

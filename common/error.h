@@ -1,40 +1,11 @@
-// Errors, in two channels (STYLE.md): CHECK for bugs, InputError for bad input.
+// Errors, in two channels (docs/conventions.md): CHECK for bugs, InputError (shrefract/error.h) for bad input.
 #pragma once
 
 #include <sstream>
 #include <stdexcept>
 #include <string>
 
-namespace shrefract {
-
-// Bad input from a user: the message names the file and the problem. Libraries throw it and
-// never exit; the command-line tools print it and exit non-zero.
-struct InputError : std::runtime_error {
-    using std::runtime_error::runtime_error;
-};
-
-// "FILE: problem" — the one format for every user-facing input error.
-inline InputError inputError(const std::string& file, const std::string& problem) {
-    return InputError(file + ": " + problem);
-}
-
-// The operating system refused a read or write that the input could not have foreseen (disk
-// full, permission denied, I/O error): not bad input, so the tools exit 1, not 2. The message
-// names the file and gives the OS's reason.
-struct IoError : std::runtime_error {
-    using std::runtime_error::runtime_error;
-};
-
-// "FILE: what: strerror(err)" (errno err, as the failing call left it).
-IoError ioError(const std::string& file, const std::string& what, int err);
-
-// The user asked to stop (Ctrl-C, SIGTERM): work is abandoned, nothing is written, the tools
-// exit 130.
-struct Cancelled : std::runtime_error {
-    Cancelled() : std::runtime_error("cancelled") {}
-};
-
-}  // namespace shrefract
+#include "shrefract/error.h"
 
 // A broken invariant is a bug in shrefract, not in the input: print both sides and abort.
 #define SHREFRACT_CHECK(cond)                                                              \

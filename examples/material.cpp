@@ -151,7 +151,7 @@ int main(int argc, char** argv) {
         }
         std::printf("material: %zu pixels, largest angle between the app's exit direction and "
                     "Refractor::draw's: %.4f deg (%s path)\n",
-                    covered, worst, refractor->path().c_str());
+                    covered, worst, shrefract::nameOf(refractor->path()));
         // The same map either way, up to float rounding and the texture unit's sub-texel weights.
         return covered > 500 && worst < 0.1 ? 0 : 1;
     } catch (const std::exception& e) {

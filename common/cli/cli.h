@@ -10,9 +10,12 @@
 
 #include <atomic>
 #include <functional>
+#include <map>
 #include <string>
 
 #include <CLI/CLI.hpp>
+
+#include "shrefract/enum_names.h"
 
 namespace shrefract::cli {
 
@@ -43,5 +46,16 @@ const std::atomic<bool>* cancelOnSignals();
 // "note: MESSAGE" on stderr: the tool chose something the user did not ask for literally (a
 // value rounded or clamped). Say what you do.
 void note(const std::string& tool, const std::string& message);
+
+// An option whose value is one of an enumeration's names (shrefract/enum_names.h): the help
+// lists the names and shows the default by name, and any other word is a usage error.
+template <class E>
+CLI::Option* addEnumOption(CLI::App& app, const std::string& flags, E& value, const std::string& help) {
+    std::map<std::string, E> names;
+    for (const NamedValue<E>& v : EnumNames<E>::table) names.emplace(v.name, v.value);
+    return app.add_option(flags, value, help)
+        ->transform(CLI::CheckedTransformer(names))
+        ->default_str(nameOf(value));
+}
 
 }  // namespace shrefract::cli

@@ -46,28 +46,30 @@ int main(int argc, char** argv) {
     CLI::App app{"Precision and cost of the polynomial and recurrence SH forms in GLSL"};
     std::vector<int> orders, timingOrders = {8, 12, 16};
     for (int L = 2; L <= 20; ++L) orders.push_back(L);
-    std::string backend = "egl", preset = "modern", jsonPath;
+    std::string jsonPath;
+    Backend backend = Backend::Egl;
+    ShaderPreset preset = ShaderPreset::Modern;
     int rate = 16, timingRate = 48, frames = 9;
     app.add_option("--orders", orders, "orders measured for error")->delimiter(',');
     app.add_option("--timing-orders", timingOrders, "orders also timed")->delimiter(',');
     app.add_option("--rate", rate, "layout rate of the error bake (samples per edge)");
     app.add_option("--timing-rate", timingRate, "layout rate of the timing bake");
     app.add_option("--frames", frames, "timed updates per order and form (median)");
-    app.add_option("--backend", backend, "egl | osmesa");
-    app.add_option("--preset", preset, "shader limits: modern | 2006");
+    cli::addEnumOption(app, "--backend", backend, "egl | osmesa");
+    cli::addEnumOption(app, "--preset", preset, "shader limits: modern | 2006");
     app.add_option("--json", jsonPath, "write the results here");
     return cli::run(app, "shrefract-bench-shforms", argc, argv, [&] {
-        auto context = createHeadlessContext(parseBackend(backend));
+        auto context = createHeadlessContext(backend);
         nlohmann::json out;
         out["renderer"] = context->description();
-        out["preset"] = preset;
+        out["preset"] = nameOf(preset);
         out["recurrence_from_order"] = kRecurrenceFromOrder;
         out["rate"] = rate;
         out["timing_rate"] = timingRate;
         out["frames"] = frames;
         out["weights"] = "uniform [-1, 1]";
         out["results"] = nlohmann::json::array();
-        std::printf("%s, preset %s\n", context->description().c_str(), preset.c_str());
+        std::printf("%s, preset %s\n", context->description().c_str(), nameOf(preset));
         std::printf("order  coeffs  absSum    form        max err    median err  ms\n");
         for (int L : orders) {
             const bool timed =
@@ -76,10 +78,11 @@ int main(int argc, char** argv) {
             Bake bake = makeBake(data);
             Bake timingBake = timed ? makeBake(test::uniformWeightBake(L, timingRate)) : Bake();
             const double absSum = maxAbsSum(L);
-            for (const char* form : {"polynomial", "recurrence"}) {
+            for (const ShForm shForm : {ShForm::Polynomial, ShForm::Recurrence}) {
+                const char* form = nameOf(shForm);
                 RefractorOptions o;
                 o.preset = preset;
-                o.form = form;
+                o.form = shForm;
                 o.loader = context->loader();
                 nlohmann::json row = {{"order", L},
                                       {"form", form},

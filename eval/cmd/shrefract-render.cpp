@@ -77,12 +77,14 @@ double meanAbsDifference(const RenderedFrame& a, const RenderedFrame& b, float e
 
 int main(int argc, char** argv) {
     CLI::App app{"Render a shrefract bake (interactive refraction, Genevaux et al. 2006) headless"};
-    std::string bakePath, envPath, camera, eye, target, size = "1024x1024", backend = "egl";
-    std::string out, outExr, dirs, dumpDir, preset = "modern", form = "auto";
+    std::string bakePath, envPath, camera, eye, target, size = "1024x1024";
+    std::string out, outExr, dirs, dumpDir;
+    Backend backend = Backend::Egl;
     float fov = 45.0f, exposure = 1.0f;
     int order = -1, frames = 5, spp = 1;
     bool smoothing = false;
-    std::string method = "sh", wymanTir = "reflect", scenePath, absorption, flicker, flickerJson;
+    std::string method = "sh", scenePath, absorption, flicker, flickerJson;
+    WymanTir tir = WymanTir::Reflect;
     bool latLongLookup = false, noVerify = false;
     std::string iorText, bracketPath;
     RefractorOptions sh;  // defaults shown in --help
@@ -94,16 +96,16 @@ int main(int argc, char** argv) {
     app.add_option("--fov", fov, "vertical field of view, degrees")->capture_default_str();
     app.add_option("--size", size, "image size WxH")->capture_default_str();
     app.add_option("--order", order, "SH order used at runtime (default: all stored)");
-    app.add_option("--backend", backend, "headless GL: egl | osmesa")->capture_default_str();
-    app.add_option("--preset", preset, "shader limits: modern | 2006")->capture_default_str();
-    app.add_option("--path", sh.path, "sh: interpolation, direct | rho | auto (direct for modern, rho for 2006)")
-        ->capture_default_str()->check(CLI::IsMember({"direct", "rho", "auto"}));
-    app.add_option("--decompression", sh.decompression, "sh, direct path: vertex | texture | auto")
-        ->capture_default_str()->check(CLI::IsMember({"vertex", "texture", "auto"}));
-    app.add_option("--shading", sh.shading,
-                   "sh: spread (lobes from the predicted error, or the SH length, and the pixel "
-                   "footprint) | sharp (the paper's lookup) | blend (the two mixed by the lobe's width) | jitter (one stable direction drawn from the lobe)")
-        ->capture_default_str()->check(CLI::IsMember({"spread", "sharp", "blend", "jitter"}));
+    cli::addEnumOption(app, "--backend", backend, "headless GL: egl | osmesa");
+    cli::addEnumOption(app, "--preset", sh.preset, "shader limits: modern | 2006");
+    cli::addEnumOption(app, "--path", sh.path,
+                       "sh: interpolation, direct | rho | charts | auto (direct for modern, rho for "
+                       "2006, charts for chart bakes)");
+    cli::addEnumOption(app, "--decompression", sh.decompression, "sh, direct path: vertex | texture | auto");
+    cli::addEnumOption(app, "--shading", sh.shading,
+                       "sh: spread (lobes from the predicted error, or the SH length, and the pixel "
+                       "footprint) | sharp (the paper's lookup) | blend (the two mixed by the lobe's "
+                       "width) | jitter (one stable direction drawn from the lobe)");
     app.add_option("--jitter-cell", sh.jitterCell, "sh, jitter shading: the cell of one drawn direction, a fraction of the object's bounding-box diagonal")
         ->capture_default_str()->check(CLI::Range(1e-6f, 10.0f));
     app.add_option("--blend-sigma", sh.blendSigma, "sh, blend shading: lobe width (radians) at which the lobe has half the weight")
@@ -116,8 +118,7 @@ int main(int argc, char** argv) {
     app.add_option("--footprint-scale", sh.footprintScale, "sh, spread shading: screen footprint factor")
         ->capture_default_str()->check(CLI::Range(0.0f, 100.0f));
     app.add_flag("--half-weights", sh.halfWeights, "sh: upload float32 weights as RGBA16F");
-    app.add_option("--form", form, "SH evaluation in GLSL: auto | polynomial | recurrence")
-        ->capture_default_str()->check(CLI::IsMember({"auto", "polynomial", "recurrence"}));
+    cli::addEnumOption(app, "--form", sh.form, "SH evaluation in GLSL: auto | polynomial | recurrence");
     app.add_option("--frames", frames, "frames timed after a warm-up (median wall ms per frame)")->capture_default_str();
     app.add_option("--spp", spp,
                    "raytrace: stratified samples per pixel for the colour (64: the anti-aliased "
@@ -143,9 +144,8 @@ int main(int argc, char** argv) {
                    "direction (docs/format.md)");
     app.add_option("--method", method, "sh | single | wyman | raytrace")->capture_default_str()
         ->check(CLI::IsMember({"sh", "single", "wyman", "raytrace"}));
-    app.add_option("--wyman-tir", wymanTir,
-                   "Wyman at total internal reflection: reflect | straight | grazing")
-        ->capture_default_str();
+    cli::addEnumOption(app, "--wyman-tir", tir,
+                       "Wyman at total internal reflection: reflect | straight | grazing");
     app.add_flag("--latlong-lookup", latLongLookup,
                  "raytrace: look the environment up bilinearly in the lat-long image, not through "
                  "the runtime's cube map");
@@ -162,7 +162,14 @@ int main(int argc, char** argv) {
     app.add_option("--ior-bracket", bracketPath,
                    "sh with --ior: a second bake of the same mesh at another index, interpolated "
                    "with BAKE per channel instead of the straight path");
-    std::string seamsOf, seamsJson;
+    std::string seamsOf, seamsJson, jsonPath;
+    bool stageTimers = false;
+    app.add_option("--json", jsonPath,
+                   "write what the render measured here as JSON (- for stdout): ms per frame and "
+                   "how it was timed, GPU memory, coverage, seams, flicker; what scripts read");
+    app.add_flag("--stage-timers", stageTimers,
+                 "GL timer queries around each stage of the warm frame, printed as GPU ms (each "
+                 "waits for the GPU; the ms per frame is always measured without them)");
     app.add_option("--seams-of", seamsOf,
                    "a chart bake whose smooth seams to measure the render's jump across "
                    "(default: this bake, if it is one)");
@@ -176,6 +183,8 @@ int main(int argc, char** argv) {
         const std::string stagedDirs = dirs.empty() ? "" : outputs.add(dirs);
         const std::string stagedFlicker = flickerJson.empty() ? "" : outputs.add(flickerJson);
         const std::string stagedSeams = seamsJson.empty() ? "" : outputs.add(seamsJson);
+        const std::string stagedJson = jsonPath.empty() || jsonPath == "-" ? "" : outputs.add(jsonPath);
+        nlohmann::json summary = {{"method", method}, {"bake", bakePath}};
         int width = 0, height = 0;
         char x = 0;
         std::istringstream sizeStream(size);
@@ -208,8 +217,6 @@ int main(int argc, char** argv) {
                 throw std::invalid_argument("--flicker: expected N:STEP with N >= 2, got '" + flicker + "'");
             if (!eye.empty()) throw std::invalid_argument("--flicker orbits: give --camera orbit:AZ,EL,DIST");
         }
-        const Backend be = parseBackend(backend);
-        const WymanTir tir = parseWymanTir(wymanTir);
         if (spp > 1 && method != "raytrace")
             throw std::invalid_argument("--spp " + std::to_string(spp) +
                                         ": only --method raytrace takes several samples per pixel");
@@ -242,11 +249,7 @@ int main(int argc, char** argv) {
             for (float k : kappa)
                 if (!(k >= 0.0f) || !std::isfinite(k))
                     throw std::invalid_argument("--absorption: kappa must be finite and >= 0, got '" + absorption + "'");
-            BakeData tinted = bake.data();
-            if (!tinted.manifest.contains("media") || tinted.manifest["media"].empty())
-                tinted.manifest["media"] = nlohmann::json::array({nlohmann::json::object()});
-            tinted.manifest["media"][0]["absorption"] = {kappa[0], kappa[1], kappa[2]};
-            bake = makeBake(std::move(tinted));
+            sh.absorption = glm::vec3(kappa[0], kappa[1], kappa[2]);
         }
 
         std::unique_ptr<BakeData> seamBake;  // whose seams to measure the render's jump across
@@ -323,20 +326,20 @@ int main(int argc, char** argv) {
                 return f;
             };
         } else {
-            context = createHeadlessContext(be, width, height);
-            std::printf("GL: %s (%s)\n", context->description().c_str(), ToString(be));
+            context = createHeadlessContext(backend, width, height);
+            std::printf("GL: %s (%s)\n", context->description().c_str(), nameOf(backend));
+            summary["renderer"] = context->description();
             env = std::make_unique<Environment>(Environment::loadLatLong(envPath));
             if (method == "sh") {
                 RefractorOptions options = sh;
                 options.errorModel = !noErrorModel;
-                options.preset = preset;
-                options.form = form;
                 options.order = order;
                 options.maxOrder = order;  // only the bands used go to the GPU (paper Figure 12)
                 options.smoothing = smoothing;
                 options.gutter = gutter;
                 options.seamAware = seamAware == "on";
                 options.loader = context->loader();
+                options.timings = stageTimers;
                 refractor = Refractor::create(bake, options);
                 if (ior.x > 0) {
                     refractor->setIor(ior);
@@ -354,12 +357,17 @@ int main(int argc, char** argv) {
                             bake.order(), bake.sampleCount(), bake.triangleCount(),
                             bake.layout().c_str(), bake.layout() == "joining" ? "rho" : "atlas",
                             refractor->refractionMapSize().x, refractor->refractionMapSize().y,
-                            refractor->order(), refractor->passCount(), preset.c_str(),
-                            refractor->path().c_str(), refractor->decompression().c_str(),
-                            options.shading.c_str(), refractor->memory().total() / 1e6);
+                            refractor->order(), refractor->passCount(), nameOf(options.preset),
+                            nameOf(refractor->path()), nameOf(refractor->decompression()),
+                            nameOf(options.shading), refractor->memory().total() / 1e6);
                 if (bake.layout() != "joining")
                     std::printf("charts: gutter %d texels, seam-aware %s\n", refractor->gutter(),
                                 refractor->seamAware() ? "on" : "off");
+                summary["order"] = refractor->order();
+                summary["passes"] = refractor->passCount();
+                summary["path"] = nameOf(refractor->path());
+                summary["decompression"] = nameOf(refractor->decompression());
+                summary["shading"] = nameOf(options.shading);
                 if (!dumpDir.empty()) refractor->dumpShaders(dumpDir);
                 if (bake.layout() != "joining") {  // the map's own jump across the seams
                     refractor->update(cam.eye);
@@ -368,6 +376,7 @@ int main(int argc, char** argv) {
                     for (size_t i = 0; i < map.size(); ++i)
                         map[i] = {mp[4 * i], mp[4 * i + 1], mp[4 * i + 2], mp[4 * i + 3]};
                     nlohmann::json st = jumpStats({}, seamJumps(bake.data().layout, map));
+                    summary["mapSeams"] = st;
                     if (st["count"].get<size_t>() > 0)
                         std::printf("refraction map across %zu smooth seam points: jump median %.3f, "
                                     "p95 %.3f deg\n",
@@ -382,7 +391,9 @@ int main(int argc, char** argv) {
                 };
             } else {
                 BaselineOptions options;
-                options.method = parseBaselineMethod(method);
+                options.method = parseName<BaselineMethod>(method);
+                options.absorption = sh.absorption;
+                options.timings = stageTimers;
                 options.tir = tir;
                 options.loader = context->loader();
                 std::vector<float> normalDistance;
@@ -422,6 +433,8 @@ int main(int argc, char** argv) {
                           nlohmann::json{{"method", method}, {"frames", flickerFrames}, {"stepDeg", flickerStep},
                                          {"meanAbsDifference", mean}, {"differences", diffs}}.dump(1) + "\n");
             msPerFrame = ms;
+            summary["flicker"] = {{"frames", flickerFrames}, {"stepDeg", flickerStep},
+                                  {"meanAbsDifference", mean}};
         } else {
             // The reference is traced once. A GL method draws a warm-up frame first (llvmpipe
             // JIT-compiles shaders at the first draw), so that the GPU stage times printed below
@@ -432,17 +445,29 @@ int main(int argc, char** argv) {
             msPerFrame = ms;
             if (refractor) {
                 const Timings& t = frame.timings;
-                std::printf("GPU ms: view %.3f, decompress %.3f (%d passes), smooth %.3f, unpack "
-                            "%.3f, shade %.3f\n",
-                            t.view, t.decompress, t.passes, t.smooth, t.unpack, t.shade);
+                if (stageTimers) {
+                    std::printf("GPU ms: view %.3f, decompress %.3f (%d passes), smooth %.3f, unpack "
+                                "%.3f, shade %.3f\n",
+                                t.view, t.decompress, t.passes, t.smooth, t.unpack, t.shade);
+                    summary["stageMs"] = {{"view", t.view}, {"decompress", t.decompress},
+                                          {"smooth", t.smooth}, {"unpack", t.unpack}, {"shade", t.shade}};
+                }
+                const GpuMemory& g = refractor->memory();
+                const double extra = bracket ? bracket->memory().total() / 1e6 : 0.0;
                 if (bracket)
-                    std::printf("GPU memory: %.1f MB + bracketing bake %.1f MB\n",
-                                refractor->memory().total() / 1e6, bracket->memory().total() / 1e6);
+                    std::printf("GPU memory: %.1f MB + bracketing bake %.1f MB\n", g.total() / 1e6, extra);
                 else
-                    std::printf("GPU memory: %.1f MB\n", refractor->memory().total() / 1e6);
-            } else if (baseline) {
+                    std::printf("GPU memory: %.1f MB\n", g.total() / 1e6);
+                summary["gpuMemoryMB"] = g.total() / 1e6 + extra;
+                summary["gpuMemoryPartsMB"] = {{"weights", g.weights / 1e6}, {"samples", g.samples / 1e6},
+                                               {"rho", g.rho / 1e6}, {"neighbours", g.neighbours / 1e6},
+                                               {"mesh", g.mesh / 1e6}, {"targets", g.targets / 1e6},
+                                               {"bracketingBake", extra}};
+            } else if (baseline && stageTimers) {
                 std::printf("GPU ms: back faces %.3f, shade %.3f\n", baseline->timings().backFaces,
                             baseline->timings().shade);
+                summary["stageMs"] = {{"backFaces", baseline->timings().backFaces},
+                                      {"shade", baseline->timings().shade}};
             }
         }
         if (m.wallMs) {
@@ -451,6 +476,8 @@ int main(int argc, char** argv) {
                        std::to_string(std::max(1, frames)) + " after a warm-up";
         }
         std::printf("ms per frame (%s): %.3f (%s)\n", method.c_str(), msPerFrame, m.timing.c_str());
+        summary["msPerFrame"] = msPerFrame;
+        summary["timing"] = m.timing;
         if (seamBake) {
             ReferenceView view;
             view.eye = cam.eye, view.target = cam.target, view.up = cam.up;
@@ -465,16 +492,20 @@ int main(int argc, char** argv) {
             else
                 std::printf("seams: no pixel pair straddles a visible smooth seam\n");
             if (!seamsJson.empty()) writeFile(stagedSeams, st.dump(2) + "\n");
+            summary["seams"] = st;
         }
         size_t covered = 0;
         for (size_t i = 3; i < frame.directions.size(); i += 4) covered += frame.directions[i] > 0;
         std::printf("coverage: %.1f%% of pixels\n", 100.0 * covered / (size_t(width) * height));
+        summary["coverage"] = double(covered) / (double(width) * height);
+        if (!stagedJson.empty()) writeFile(stagedJson, summary.dump(1) + "\n");
         if (!out.empty()) shrefract::writePng(stagedPng, frame, exposure);
         if (!outExr.empty()) shrefract::writeExr(stagedExr, width, height, frame.color);
         if (!dirs.empty())
             shrefract::writeEvalBuffer(
                 stagedDirs, shrefract::makeEvalBuffer(width, height, frame.color, frame.directions));
         outputs.commit();  // all or none
+        if (jsonPath == "-") std::printf("%s\n", summary.dump(1).c_str());
         return shrefract::cli::kOk;
     });
 }

@@ -115,7 +115,8 @@ void onGlfwError(int code, const char* text) {
 
 int main(int argc, char** argv) {
     CLI::App app{"Interactive viewer for a shrefract bake"};
-    std::string bakePath, envPath, size = "1024x768", preset = "modern", screenshotPath;
+    std::string bakePath, envPath, size = "1024x768", screenshotPath;
+    shrefract::ShaderPreset preset = shrefract::ShaderPreset::Modern;
     int order = -1, frames = 0;
     float exposure = 1.0f;
     bool smoothing = false, noObject = false, noVerify = false;
@@ -123,7 +124,7 @@ int main(int argc, char** argv) {
     app.add_option("--env", envPath, "lat-long environment EXR")->required();
     app.add_option("--size", size, "window size WxH")->capture_default_str();
     app.add_option("--order", order, "SH order used at start (default: all stored)");
-    app.add_option("--preset", preset, "shader limits: modern | 2006")->capture_default_str();
+    shrefract::cli::addEnumOption(app, "--preset", preset, "shader limits: modern | 2006");
     app.add_flag("--smooth", smoothing, "start with spatial smoothing on");
     app.add_option("--exposure", exposure, "exposure before the tone map")->capture_default_str();
     app.add_option("--screenshot", screenshotPath, "save the last frame here and exit (with --frames)");
@@ -283,7 +284,7 @@ int main(int argc, char** argv) {
                 std::snprintf(title, sizeof title,
                               "shrefract-view | sh order %d (%s, %d pass) smooth %s%s | %.1f ms/frame | "
                               "view %.2f dec %.2f smooth %.2f %s %.2f shade %.2f ms",
-                              refractor->order(), refractor->path().c_str(), refractor->passCount(),
+                              refractor->order(), shrefract::nameOf(refractor->path()), refractor->passCount(),
                               v.smoothing ? "on" : "off", chartState, frameMs, t.view, t.decompress,
                               t.smooth, charts ? "gutters" : "unpack", t.unpack, t.shade);
             } else {

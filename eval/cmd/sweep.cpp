@@ -61,7 +61,8 @@ std::vector<int> parseInts(const std::string& s) {
 
 int main(int argc, char** argv) {
     CLI::App app{"shrefract-sweep: per-pixel error against ms per frame and memory, one mesh"};
-    std::string mesh, envPath = "data/envmaps/courtyard.exr", jsonPath, csvPath, backend = "egl";
+    std::string mesh, envPath = "data/envmaps/courtyard.exr", jsonPath, csvPath;
+    Backend backend = Backend::Egl;
     std::string ratesText = "1", gridsText = "16x32,32x64", ordersText = "1,2,3,4,5,6,8,10,12";
     int size = 256, frames = 3, spp = 64;
     double ior = 1.5;
@@ -78,7 +79,7 @@ int main(int argc, char** argv) {
     app.add_option("--grids", gridsText, "direction grids to trace")->capture_default_str();
     app.add_option("--orders", ordersText, "SH orders (truncations of the highest)")->capture_default_str();
     app.add_option("--ior", ior)->capture_default_str();
-    app.add_option("--backend", backend)->capture_default_str();
+    cli::addEnumOption(app, "--backend", backend, "headless GL: egl | osmesa");
     bool table1 = false;
     app.add_flag("--table1", table1,
                  "instead: one row of the paper's Table 1 (order 8, 32x64, --samples 35000, "
@@ -95,7 +96,7 @@ int main(int argc, char** argv) {
         Medium medium;
         medium.ior = ior;
         Scene scene = loadScene(mesh, medium);
-        auto context = createHeadlessContext(parseBackend(backend), size, size);
+        auto context = createHeadlessContext(backend, size, size);
         Environment environment = Environment::loadLatLong(envPath);
         ReferenceEnvironment refEnv(loadLatLong(envPath));
         Tracer tracer(scene, TraceOptions{});
@@ -247,12 +248,12 @@ int main(int argc, char** argv) {
                 }
                 // The 2006 multipass preset, and the two SH forms, at order 8 and the top order.
                 for (int L : std::set<int>{8, Lmax}) {
-                    for (const char* preset : {"2006", "modern"})
-                        for (const char* form : {"polynomial", "recurrence"}) {
+                    for (ShaderPreset preset : {ShaderPreset::Paper2006, ShaderPreset::Modern})
+                        for (ShForm form : {ShForm::Polynomial, ShForm::Recurrence}) {
                             RefractorOptions o;
                             o.maxOrder = L, o.order = L, o.preset = preset, o.form = form;
                             try {
-                                point("preset", std::string(preset) + "/" + form + "/L" + std::to_string(L), L,
+                                point("preset", std::string(nameOf(preset)) + "/" + nameOf(form) + "/L" + std::to_string(L), L,
                                       renderSh(full, o));
                             } catch (const std::exception& e) {
                                 std::fprintf(stderr, "  preset %s form %s L%d: %s\n", preset, form, L, e.what());

@@ -96,8 +96,9 @@ nlohmann::json memoryJson(const GpuMemory& m) {
 // "direct:vertex" -> options.path "direct", options.decompression "vertex".
 void applyPath(const std::string& text, RefractorOptions& o) {
     const size_t colon = text.find(':');
-    o.path = text.substr(0, colon);
-    o.decompression = colon == std::string::npos ? "auto" : text.substr(colon + 1);
+    o.path = parseName<RefractorPath>(text.substr(0, colon));
+    o.decompression = colon == std::string::npos ? DecompressionSite::Auto
+                                                 : parseName<DecompressionSite>(text.substr(colon + 1));
 }
 
 std::vector<std::string> split(const std::string& text) {
@@ -137,7 +138,7 @@ int main(int argc, char** argv) {
     app.add_option("--json", jsonPath, "output file (default: stdout)");
     return cli::run(app, "shrefract-bench-runtime", argc, argv, [&] {
         Bake bake = loadBake(bakePath);
-        auto context = createHeadlessContext(parseBackend(backend));
+        auto context = createHeadlessContext(parseName<Backend>(backend));
         Environment env = Environment::loadLatLong(envPath);
         ensureLoaded(currentContextLoader());
         std::fprintf(stderr, "GL: %s\n", context->description().c_str());
@@ -225,7 +226,7 @@ int main(int argc, char** argv) {
                 }
                 RefractorOptions options;
                 applyPath(pathText, options);
-                options.preset = preset;
+                options.preset = parseName<ShaderPreset>(preset);
                 options.order = order;
                 options.maxOrder = order;  // upload only what this order uses (Figure 12)
                 options.smoothing = smoothing;
@@ -258,8 +259,8 @@ int main(int argc, char** argv) {
                         for (int i = 0; i < 5; ++i) st[i].push_back(values[i]);
                     });
                     nlohmann::json run = {
-                        {"path", refractor->path()},
-                        {"decompression", refractor->decompression()},
+                        {"path", nameOf(refractor->path())},
+                        {"decompression", nameOf(refractor->decompression())},
                         {"preset", preset},
                         {"order", order},
                         {"viewport", std::to_string(vp.x) + "x" + std::to_string(vp.y)},
@@ -319,8 +320,8 @@ int main(int argc, char** argv) {
                 r->update(glm::vec3(0.0f, 0.0f, 3.0f));  // render targets are made on first use
                 others.push_back({{"bake", path},
                                   {"precision", other.data().manifest.value("precision", "")},
-                                  {"path", r->path()},
-                                  {"decompression", r->decompression()},
+                                  {"path", nameOf(r->path())},
+                                  {"decompression", nameOf(r->decompression())},
                                   {"memory", memoryJson(r->memory())}});
                 std::fprintf(stderr, "%s %s: %.2f MB\n", path.c_str(), pathText.c_str(),
                              r->memory().total() / 1e6);

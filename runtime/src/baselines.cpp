@@ -4,6 +4,7 @@
 #include "shrefract/baselines.h"
 
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 
 #include <glm/gtc/matrix_inverse.hpp>
@@ -12,24 +13,13 @@
 #include "common/bakefile.h"
 #include "gl.h"
 #include "environment_gl.h"
+#include "frame_uniforms.h"
+#include "gpu_timer.h"
 #include "shaders.h"
 
 namespace shrefract {
 
 using namespace gl;
-
-BaselineMethod parseBaselineMethod(const std::string& text) {
-    if (text == "single") return BaselineMethod::Single;
-    if (text == "wyman") return BaselineMethod::Wyman;
-    throw std::invalid_argument("unknown baseline method '" + text + "' (single | wyman)");
-}
-
-WymanTir parseWymanTir(const std::string& text) {
-    if (text == "reflect") return WymanTir::Reflect;
-    if (text == "straight") return WymanTir::Straight;
-    if (text == "grazing") return WymanTir::Grazing;
-    throw std::invalid_argument("unknown --wyman-tir '" + text + "' (reflect | straight | grazing)");
-}
 
 struct Baseline::Impl {
     Bake bake;
@@ -38,21 +28,10 @@ struct Baseline::Impl {
     GLuint backProgram = 0, shadeProgram = 0, vao = 0, vbo = 0;
     GLuint backTexture = 0, backDepth = 0, backFbo = 0;
     int backW = 0, backH = 0, vertexCount = 0;
-    GLuint queries[2] = {};
+    std::unique_ptr<GpuStageTimer> timer;  // stages: 0 back faces, 1 shading
     BaselineTimings timings;
 
     void use() const { ensureLoaded(loader); }
-    void begin(int q) {
-        if (options.timings) glBeginQuery(GL_TIME_ELAPSED, queries[q]);
-    }
-    void end(int q, double* ms) {
-        if (!options.timings) return;
-        glFinish();  // llvmpipe defers work to a flush (as in refractor.cpp)
-        glEndQuery(GL_TIME_ELAPSED);
-        GLuint64 ns = 0;
-        glGetQueryObjectui64v(queries[q], GL_QUERY_RESULT, &ns);
-        *ms = ns * 1e-6;
-    }
     void resizeBack(int w, int h) {
         if (w == backW && h == backH) return;
         if (backFbo) glDeleteFramebuffers(1, &backFbo);
@@ -122,7 +101,8 @@ std::unique_ptr<Baseline> Baseline::create(const Bake& bake, const std::vector<f
     glVertexAttribPointer(2, 1, GL_FLOAT, GL_FALSE, 7 * sizeof(float),
                           reinterpret_cast<void*>(6 * sizeof(float)));
     glBindVertexArray(0);
-    glGenQueries(2, m->queries);
+    m->timer = std::make_unique<GpuStageTimer>(2);
+    m->timer->setEnabled(options.timings);
     SHREFRACT_GL_CHECK();
     return std::unique_ptr<Baseline>(new Baseline(std::move(m)));
 }
@@ -132,6 +112,7 @@ Baseline::~Baseline() {
     try {
         m.use();
     } catch (...) {
+        (void)m.timer.release();  // no GL any more: nothing to release safely
         return;
     }
     glDeleteProgram(m.backProgram);
@@ -141,10 +122,14 @@ Baseline::~Baseline() {
     if (m.backFbo) glDeleteFramebuffers(1, &m.backFbo);
     if (m.backTexture) glDeleteTextures(1, &m.backTexture);
     if (m.backDepth) glDeleteRenderbuffers(1, &m.backDepth);
-    glDeleteQueries(2, m.queries);
 }
 
 const BaselineTimings& Baseline::timings() const { return impl_->timings; }
+void Baseline::setTimings(bool on) {
+    if (!on) impl_->timings = BaselineTimings{};
+    impl_->timer->setEnabled(on);
+}
+bool Baseline::timingsEnabled() const { return impl_->timer->enabled(); }
 
 void Baseline::draw(const glm::mat4& view, const glm::mat4& projection, const glm::mat4& model,
                     const Environment& environment) {
@@ -153,19 +138,16 @@ void Baseline::draw(const glm::mat4& view, const glm::mat4& projection, const gl
     GLint viewport[4], framebuffer = 0;
     glGetIntegerv(GL_VIEWPORT, viewport);
     glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &framebuffer);
-    const glm::mat4 vp = projection * view;
-    const glm::mat3 rotation(model);
-    const glm::mat3 normalMatrix = glm::inverseTranspose(rotation);
-    const glm::vec3 eye = glm::vec3(glm::inverse(view)[3]);
-    const float scale = std::cbrt(std::abs(glm::determinant(rotation)));
+    FrameUniforms frame(view, projection, model);
+    frame.eta = m.bake.ior();
+    frame.kappa = m.options.absorption.value_or(m.bake.absorption());
+    frame.toneMap = m.options.toneMap;
+    frame.exposure = m.options.exposure;
+    const float scale = std::cbrt(std::abs(glm::determinant(glm::mat3(model))));
     auto common = [&](GLuint p) {
         glUseProgram(p);
-        glUniformMatrix4fv(glGetUniformLocation(p, "uModel"), 1, GL_FALSE, glm::value_ptr(model));
-        glUniformMatrix4fv(glGetUniformLocation(p, "uViewProjection"), 1, GL_FALSE,
-                           glm::value_ptr(vp));
+        frame.set(p);
         glUniformMatrix4fv(glGetUniformLocation(p, "uView"), 1, GL_FALSE, glm::value_ptr(view));
-        glUniformMatrix3fv(glGetUniformLocation(p, "uNormalMatrix"), 1, GL_FALSE,
-                           glm::value_ptr(normalMatrix));
     };
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
@@ -175,7 +157,7 @@ void Baseline::draw(const glm::mat4& view, const glm::mat4& projection, const gl
     m.timings.backFaces = 0;
     const bool wyman = m.options.method == BaselineMethod::Wyman;
     if (wyman) {
-        m.begin(0);
+        m.timer->begin(0);
         m.resizeBack(viewport[2], viewport[3]);
         glBindFramebuffer(GL_FRAMEBUFFER, m.backFbo);
         glViewport(0, 0, viewport[2], viewport[3]);
@@ -185,22 +167,16 @@ void Baseline::draw(const glm::mat4& view, const glm::mat4& projection, const gl
         glDrawArrays(GL_TRIANGLES, 0, m.vertexCount);
         glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
         glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
-        m.end(0, &m.timings.backFaces);
+        m.timer->end(0, &m.timings.backFaces);
     }
 
-    m.begin(1);
+    m.timer->begin(1);
     GLuint p = m.shadeProgram;
     common(p);
-    glUniform3f(glGetUniformLocation(p, "uEye"), eye.x, eye.y, eye.z);
-    glUniform1f(glGetUniformLocation(p, "uEta"), m.bake.ior());
-    const glm::vec3 kappa = m.bake.absorption();
-    glUniform3f(glGetUniformLocation(p, "uKappa"), kappa.x, kappa.y, kappa.z);
     glUniform1f(glGetUniformLocation(p, "uScale"), scale);
     glUniform1i(glGetUniformLocation(p, "uMethod"), wyman ? 1 : 0);
     glUniform1i(glGetUniformLocation(p, "uTir"), static_cast<int>(m.options.tir));
     glUniform2f(glGetUniformLocation(p, "uViewportOrigin"), float(viewport[0]), float(viewport[1]));
-    glUniform1i(glGetUniformLocation(p, "uToneMap"), m.options.toneMap ? 1 : 0);
-    glUniform1f(glGetUniformLocation(p, "uExposure"), m.options.exposure);
     useEnvironment(p, environment, 0);
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, wyman ? m.backTexture : 0);
@@ -208,7 +184,7 @@ void Baseline::draw(const glm::mat4& view, const glm::mat4& projection, const gl
     glBindVertexArray(0);
     glUseProgram(0);
     glActiveTexture(GL_TEXTURE0);
-    m.end(1, &m.timings.shade);
+    m.timer->end(1, &m.timings.shade);
     SHREFRACT_GL_CHECK();
 }
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "common/decompress.h"
+#include "ior.h"
 #include "shaders.h"
 
 namespace shrefract {
@@ -27,17 +28,26 @@ void setSamplers(GLuint program, std::initializer_list<const char*> names) {
 
 }  // namespace
 
-const std::string& ChartPipeline::textureSpaceVertexShader() {
+const std::string& ChartPipeline::vertexShader() const {
     return shaders::source("chart_texture.vert");
 }
 
-ChartPipeline::ChartPipeline(const SurfaceLayout& layout, GLuint meshVao, int vertices,
-                             int dilation, bool seamAware)
-    : layout_(layout), meshVao_(meshVao), vertices_(vertices), width_(layout.muWidth),
-      height_(layout.muHeight), dilation_(std::max(0, dilation)), seamAware_(seamAware) {
+ChartPipeline::ChartPipeline(const PipelineInputs& in)
+    : layout_(in.bake.data().layout), settings_(in.settings), width_(layout_.muWidth),
+      height_(layout_.muHeight),
+      dilation_(std::max(0, in.options.gutter < 0 ? layout_.atlas.gutter : in.options.gutter)),
+      seamAware_(in.options.seamAware), mesh_(in.bake, in.memory) {
+    const SurfaceLayout& layout = layout_;
+    if (in.options.path != RefractorPath::Auto && in.options.path != RefractorPath::Charts)
+        throw std::invalid_argument(std::string("shrefract: path \"") + nameOf(in.options.path) +
+                                    "\" for a " + ToString(layout.kind) +
+                                    " bake (chart bakes take \"charts\")");
+    // The atlas is the refraction map; the unfolded mesh draws it in texture space and shades.
+    atlas_.create(width_, height_, GL_LINEAR);
+    in.memory.targets += static_cast<size_t>(width_) * height_ * 16;
     glGenVertexArrays(1, &emptyVao_);
     const std::string& full = shaders::source("fullscreen.vert");
-    viewProgram_ = buildProgram(textureSpaceVertexShader(), shaders::source("chart_view.frag"),
+    viewProgram_ = buildProgram(vertexShader(), shaders::source("chart_view.frag"),
                                 "chart local view");
     dilateProgram_ = buildProgram(full, shaders::source("dilate.frag"), "gutter dilation");
     setSamplers(dilateProgram_, {"uD", "uRings"});
@@ -84,6 +94,11 @@ ChartPipeline::ChartPipeline(const SurfaceLayout& layout, GLuint meshVao, int ve
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glUseProgram(0);
+    in.memory.rho = indexBytes();
+    in.memory.targets += targetBytes();
+    decompression_ = std::make_unique<Decompression>(in.bake.data(), in.options, in.maxOrder,
+                                                     in.limits, in.form, *this, in.memory);
+    prepare();
 }
 
 ChartPipeline::~ChartPipeline() {
@@ -92,6 +107,7 @@ ChartPipeline::~ChartPipeline() {
     glDeleteTextures(6, textures);
     glDeleteFramebuffers(2, pingFbo_);
     glDeleteVertexArrays(1, &emptyVao_);
+    atlas_.destroy();
 }
 
 void ChartPipeline::uploadRings() {
@@ -101,8 +117,8 @@ void ChartPipeline::uploadRings() {
                            rings.data(), GL_NEAREST);
 }
 
-void ChartPipeline::setDilation(int width) {
-    width = std::max(0, width);
+void ChartPipeline::setGutter(int texels) {
+    const int width = std::max(0, texels < 0 ? layout_.atlas.gutter : texels);
     if (width == dilation_) return;
     dilation_ = width;
     uploadRings();
@@ -120,12 +136,12 @@ size_t ChartPipeline::targetBytes() const { return 2 * static_cast<size_t>(width
 void ChartPipeline::localView(glm::vec3 eye) {
     glUseProgram(viewProgram_);
     glUniform3f(glGetUniformLocation(viewProgram_, "uEye"), eye.x, eye.y, eye.z);
-    drawFootprint();
+    draw();
 }
 
-void ChartPipeline::drawFootprint() const {
-    glBindVertexArray(meshVao_);
-    glDrawArrays(GL_TRIANGLES, 0, vertices_);
+void ChartPipeline::draw() const {
+    glBindVertexArray(mesh_.vao());
+    glDrawArrays(GL_TRIANGLES, 0, mesh_.vertexCount());
     glBindVertexArray(emptyVao_);
 }
 
@@ -164,9 +180,45 @@ GLuint ChartPipeline::fillGutters(GLuint d, GLuint outFbo) {
     return outFbo ? 0 : src;
 }
 
-void ChartPipeline::smooth(GLuint src, GLuint outFbo) {
-    glViewport(0, 0, width_, height_);
-    pass(smoothProgram_, src, outFbo);
+
+int ChartPipeline::passCount() {
+    return static_cast<int>(decompression_->compiled(settings_.order).programs.size());
+}
+
+void ChartPipeline::update(glm::vec3 eyeObject, bool /*textureD: D_mu is always made*/,
+                           const StageClock& clock) {
+    eye_ = eyeObject;
+    decompression_->run(eyeObject, settings_.order, settings_.smoothing, clock);
+    buildMap(clock);
+}
+
+void ChartPipeline::buildMap(const StageClock& clock) {
+    clock.begin(kUnpack);
+    const GLuint filled = fillGutters(decompression_->result(), settings_.smoothing ? 0 : atlas_.fbo);
+    clock.end(kUnpack, &Timings::unpack);
+    directional_ = decompression_->result();
+    if (settings_.smoothing) {
+        clock.begin(kSmooth);
+        glViewport(0, 0, width_, height_);
+        pass(smoothProgram_, filled, atlas_.fbo);
+        clock.end(kSmooth, &Timings::smooth);
+        directional_ = atlas_.texture;  // readDirectionalMap(): the smoothed values
+    }
+    ready_ = true;
+}
+
+GLuint ChartPipeline::shadingProgram(IorShading* ior) {
+    return ior ? ior->program(false, width_) : mesh_.program();
+}
+
+void ChartPipeline::draw(GLuint, bool, glm::vec3) { mesh_.draw(atlas_.texture); }
+
+GLuint ChartPipeline::refractionMap() {
+    if (!ready_) {
+        decompression_->run(eye_, settings_.order, settings_.smoothing, {});
+        buildMap({});
+    }
+    return atlas_.texture;
 }
 
 }  // namespace shrefract

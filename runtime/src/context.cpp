@@ -231,14 +231,6 @@ std::unique_ptr<HeadlessContext> createHeadlessContext(Backend backend, int widt
     return std::make_unique<EglContext>();
 }
 
-Backend parseBackend(const std::string& text) {
-    if (text == "egl") return Backend::Egl;
-    if (text == "osmesa") return Backend::OSMesa;
-    throw std::invalid_argument("unknown GL backend '" + text + "' (egl | osmesa)");
-}
-
-const char* ToString(Backend backend) { return backend == Backend::Egl ? "egl" : "osmesa"; }
-
 namespace gl {
 Loader currentContextLoader() {
     OSMesaLib& lib = OSMesaLib::get(false);

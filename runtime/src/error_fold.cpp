@@ -28,7 +28,7 @@ ErrorFold::ErrorFold(const BakeData& bake, const std::vector<size_t>& texelOf)
         glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, k, width_, height_, 1, GL_RED, GL_FLOAT, layer.data());
     }
     // The SH of the error model as the weights' are generated: one pass, weights in an array.
-    ShaderLimits limits = shaderPreset("modern", 16);
+    ShaderLimits limits = shaderPreset(ShaderPreset::Modern, 16);
     const DecompressionShaders sh = generateDecompression(bake.errorOrder, limits, ShForm::Polynomial);
     if (sh.passes.size() != 1) throw std::logic_error("shrefract: the error model needs one pass");
     program_ = buildProgram(sh.vertex,

@@ -110,4 +110,17 @@ void Target::destroy() {
     fbo = texture = 0;
 }
 
+SavedTarget::SavedTarget() {
+    glGetIntegerv(GL_VIEWPORT, viewport_);
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &framebuffer_);
+}
+
+SavedTarget::~SavedTarget() {
+    glUseProgram(0);
+    glBindVertexArray(0);
+    glActiveTexture(GL_TEXTURE0);
+    glBindFramebuffer(GL_FRAMEBUFFER, static_cast<GLuint>(framebuffer_));
+    glViewport(viewport_[0], viewport_[1], viewport_[2], viewport_[3]);
+}
+
 }  // namespace shrefract::gl

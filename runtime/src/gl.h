@@ -118,6 +118,21 @@ struct Target {
     void destroy();
 };
 
+// Saves the viewport and the draw framebuffer, and puts them back (with no program, vertex array
+// or texture unit other than 0 left current) when it goes out of scope: the runtime's passes
+// render into their own targets inside an app's frame.
+class SavedTarget {
+public:
+    SavedTarget();
+    ~SavedTarget();
+    SavedTarget(const SavedTarget&) = delete;
+    SavedTarget& operator=(const SavedTarget&) = delete;
+
+private:
+    GLint viewport_[4] = {0, 0, 0, 0};
+    GLint framebuffer_ = 0;
+};
+
 // GL error check that compiles out of release builds (STYLE.md).
 #ifdef NDEBUG
 #define SHREFRACT_GL_CHECK() ((void)0)

@@ -16,37 +16,20 @@
 
 namespace shrefract {
 
-ShaderLimits shaderPreset(const std::string& name, int maxTextureUnits) {
+ShaderLimits shaderPreset(ShaderPreset preset, int maxTextureUnits) {
     ShaderLimits l;
-    l.name = name;
-    if (name == "2006") {
+    l.name = nameOf(preset);
+    if (preset == ShaderPreset::Paper2006) {
         l.maxTextureUnits = 16;
         l.maxAluInstructions = 64;
         l.weightArray = false;
-    } else if (name == "modern") {
+        l.vertexTextureFetch = false;
+    } else {
         l.maxTextureUnits = maxTextureUnits;
         l.maxAluInstructions = 0;
         l.weightArray = true;
-    } else {
-        throw std::invalid_argument("unknown shader preset '" + name + "' (2006 | modern)");
     }
     return l;
-}
-
-const char* ToString(ShForm form) {
-    switch (form) {
-        case ShForm::Polynomial: return "polynomial";
-        case ShForm::Recurrence: return "recurrence";
-        case ShForm::Auto: return "auto";
-    }
-    return "?";
-}
-
-ShForm parseShForm(const std::string& name) {
-    for (ShForm f : {ShForm::Polynomial, ShForm::Recurrence, ShForm::Auto})
-        if (name == ToString(f)) return f;
-    throw std::invalid_argument("unknown SH evaluation form '" + name +
-                                "' (polynomial | recurrence | auto)");
 }
 
 ShForm resolveShForm(ShForm form, int order) {

@@ -32,6 +32,8 @@
 #include <string>
 #include <vector>
 
+#include "shrefract/runtime.h"
+
 namespace shrefract {
 
 struct ShaderLimits {
@@ -43,20 +45,21 @@ struct ShaderLimits {
     // The weights are RGBA8 UNORM codes (8-bit bakes uploaded as stored): each fetch becomes
     // texel * uWeightScale[k] + uWeightOffset[k] (per-coefficient uniforms; +1 ALU a function).
     bool unormWeights = false;
+    // Textures fetched in the vertex shader (the direct path draws the sample grid as a mesh and
+    // fetches D per vertex). The paper's R300 class had no vertex texture fetch.
+    bool vertexTextureFetch = true;
 };
 
-// "2006": the ATI R300 class the paper used (Radeon 9700: 16 samplers, 64 ALU instructions per
-// pass, one weight texture per function). "modern": `maxTextureUnits` (GL's
-// GL_MAX_TEXTURE_IMAGE_UNITS), unlimited ALU, weights in a 2D array: one pass.
-// Throws std::invalid_argument for other names.
-ShaderLimits shaderPreset(const std::string& name, int maxTextureUnits = 16);
+// Paper2006: the ATI R300 class the paper used (Radeon 9700: 16 samplers, 64 ALU instructions
+// per pass, one weight texture per function, no vertex texture fetch). Modern:
+// `maxTextureUnits` (GL's GL_MAX_TEXTURE_IMAGE_UNITS), unlimited ALU, weights in a 2D array: one
+// pass.
+ShaderLimits shaderPreset(ShaderPreset preset, int maxTextureUnits = 16);
 
-// How each SH function is evaluated in GLSL.
-enum class ShForm {
-    Polynomial,  // expanded Cartesian polynomial, exact integer coefficients x scale (paper §5.1)
-    Recurrence,  // associated Legendre recurrence with (x + iy)^m, float32 throughout
-    Auto,        // Recurrence from order kRecurrenceFromOrder on, Polynomial below it
-};
+// How each SH function is evaluated in GLSL (ShForm, shrefract/runtime.h): Polynomial is the
+// expanded Cartesian polynomial with exact integer coefficients x scale (paper §5.1); Recurrence
+// the associated Legendre recurrence with (x + iy)^m, float32 throughout; Auto the recurrence
+// from order kRecurrenceFromOrder on, the polynomial below it.
 
 // The order from which ShForm::Auto uses the recurrence: the first order where the polynomial's
 // float32 error is 10x the recurrence's or more. Measured (scripts/bench-shforms, llvmpipe,
@@ -70,9 +73,6 @@ enum class ShForm {
 // needs about half the passes.
 constexpr int kRecurrenceFromOrder = 12;
 
-const char* ToString(ShForm form);
-// "polynomial" | "recurrence" | "auto"; throws std::invalid_argument for anything else.
-ShForm parseShForm(const std::string& name);
 // What `form` means at `order` (Auto resolved; the others unchanged).
 ShForm resolveShForm(ShForm form, int order);
 

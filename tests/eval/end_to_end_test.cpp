@@ -67,8 +67,8 @@ protected:
                         const std::string& path = "auto", const std::string& shading = "spread") {
         RefractorOptions o;
         o.loader = context_->loader();
-        o.path = path;
-        o.shading = shading;
+        o.path = parseName<RefractorPath>(path);
+        o.shading = parseName<Shading>(shading);
         auto refractor = Refractor::create(makeBake(b.data), o);
         RenderedFrame f = renderFrame(*refractor, env, c, kSize, kSize);
         return makeEvalBuffer(kSize, kSize, f.color, f.directions);
@@ -239,4 +239,4 @@ TEST_P(EndToEnd, GpuDirectionsMatchQueryAtTheSameSurfacePoints) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, EndToEnd, ::testing::Values(Backend::Egl, Backend::OSMesa),
-                         [](const auto& info) { return std::string(ToString(info.param)); });
+                         [](const auto& info) { return std::string(nameOf(info.param)); });

@@ -68,7 +68,7 @@ TEST_P(ChartGl, DecompressionEqualsCpuAtEveryCoveredTexel) {
                 const glm::vec4 cpu = decompressSample(data, i, localViewFromEye(data.layout, i, eye));
                 for (int c = 0; c < 4; ++c) worst = std::max(worst, std::abs(gl[4 * i + c] - cpu[c]));
             }
-            std::printf("[%s] %s: max |GL - CPU| = %.3g over %d texels\n", ToString(GetParam()),
+            std::printf("[%s] %s: max |GL - CPU| = %.3g over %d texels\n", nameOf(GetParam()),
                         ToString(kind), worst, data.layout.sampleCount());
             // Measured 1e-5..4e-5: the view vector interpolated from the vertices in float, where
             // the CPU takes the sample's stored point; a wrong texel would be off by O(1).
@@ -166,7 +166,7 @@ TEST_P(ChartGl, SeamJumpShrinksFromNoGutterToGutterToSeamAware) {
                  seamAware = jump(spaced, 2, true, 0.5);
     std::printf("[%s] seam jump, degrees, median (p95): no gutter %.3f (%.3f), gutter %.3f (%.3f), "
                 "seam-aware %.3f (%.3f)\n",
-                ToString(GetParam()), none, jump(tight, 0, false, 0.95), gutter,
+                nameOf(GetParam()), none, jump(tight, 0, false, 0.95), gutter,
                 jump(spaced, 2, false, 0.95), seamAware, jump(spaced, 2, true, 0.95));
     // Measured: 1.062 (3.45), 1.010 (2.79), 0.156 (1.14). The medians of no gutter and gutter are
     // close: the shading normalizes, so the zeros of unfilled texels do not turn a direction; what
@@ -190,15 +190,15 @@ TEST_P(ChartGl, RenderCoversTheObject) {
     EXPECT_GT(covered, 64u * 64u / 10);
     EXPECT_EQ(makeBake(data).layout(), "isolated");
     // Chart bakes take their own path; the joining paths are refused for them.
-    EXPECT_EQ(r->path(), "charts");
+    EXPECT_EQ(r->path(), RefractorPath::Charts);
     RefractorOptions direct;
     direct.loader = context_->loader();
-    direct.path = "direct";
+    direct.path = RefractorPath::Direct;
     EXPECT_THROW(Refractor::create(makeBake(data), direct), std::invalid_argument);
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, ChartGl, ::testing::Values(Backend::Egl, Backend::OSMesa),
-                         [](const auto& info) { return std::string(ToString(info.param)); });
+                         [](const auto& info) { return std::string(nameOf(info.param)); });
 
 }  // namespace
 }  // namespace shrefract

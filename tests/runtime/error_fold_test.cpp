@@ -39,8 +39,8 @@ class ErrorFoldTest : public test::HeadlessTest {
 protected:
     std::unique_ptr<Refractor> make(const Bake& bake, const std::string& path, bool errorModel) {
         RefractorOptions o;
-        o.path = path;
-        o.decompression = "texture";
+        o.path = parseName<RefractorPath>(path);
+        o.decompression = DecompressionSite::Texture;
         o.errorModel = errorModel;
         o.loader = context_->loader();
         return Refractor::create(bake, o);
@@ -68,7 +68,7 @@ TEST_P(ErrorFoldTest, LengthIsThePredictedLobeAndDirectionIsKept) {
             ASSERT_EQ(f[4 * i + 3], p[4 * i + 3]) << "the path length passes through, sample " << i;
         }
         std::printf("[%s] %s: max |length - CPU| %.3g, max direction change %.3g\n",
-                    ToString(GetParam()), path, worstLength, worstDirection);
+                    nameOf(GetParam()), path, worstLength, worstDirection);
         // Measured 1.3e-4 (llvmpipe, both backends): the layers are R16F, whose 11-bit mantissa
         // rounds e_k by up to 2.4e-4 relative. The bound leaves 7x; a lobe 2 % too wide moves
         // the length by about 2e-3 at the widths here, a wrong SH sign or offset by far more.
@@ -124,10 +124,10 @@ TEST_P(ErrorFoldTest, JitterDrawsFromThePredictedLobe) {
     data.errors.assign(n, std::log(err + kErrorOffset) * std::sqrt(4.0f * float(M_PI)));
     RefractorOptions o;
     o.loader = context_->loader();
-    o.shading = "jitter";
+    o.shading = Shading::Jitter;
     o.spreadScale = 1.0f;
     o.footprintScale = 0.0f;  // the drawn direction looked up alone
-    o.decompression = "texture";
+    o.decompression = DecompressionSite::Texture;
     auto r = Refractor::create(makeBake(data), o);
     const Environment env = directionEnvironment();
     const RenderedFrame a = renderFrame(*r, env, Camera::orbit(30, 20, 3.5f), 64, 64);
@@ -160,7 +160,7 @@ TEST_P(ErrorFoldTest, JitterDrawsFromThePredictedLobe) {
     const double rms = std::sqrt(sum2 / covered), expected = std::sqrt(2.0) * spreadSigma(resultantOfSigma(err));
     const double centre = std::acos(std::clamp(glm::dot(glm::normalize(mean), glm::dvec3(e)), -1.0, 1.0));
     std::printf("[%s] %zu px: RMS angle %.4f rad (expected %.4f), mean off the exit by %.4f rad\n",
-                ToString(GetParam()), covered, rms, expected, centre);
+                nameOf(GetParam()), covered, rms, expected, centre);
     // Measured on llvmpipe: 594 pixels, RMS 0.2897 rad against 0.2803 (3 % over: a finite sample
     // of hashed draws, and the cube map's bilinear lookup), centred within 0.007 rad. A lobe of
     // the wrong width (the error not read, a missing sqrt(-2 ln u)) is off by 30 % or more.
@@ -169,7 +169,7 @@ TEST_P(ErrorFoldTest, JitterDrawsFromThePredictedLobe) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, ErrorFoldTest, ::testing::Values(Backend::Egl, Backend::OSMesa),
-                         [](const auto& info) { return std::string(ToString(info.param)); });
+                         [](const auto& info) { return std::string(nameOf(info.param)); });
 
 }  // namespace
 }  // namespace shrefract

@@ -49,7 +49,7 @@ TEST(RuntimeErrors, MissingEnvironmentIsInputError) {
 }
 
 TEST(RuntimeErrors, UnknownBackendIsRefused) {
-    EXPECT_THROW(parseBackend("vulkan"), std::invalid_argument);
+    EXPECT_THROW(parseName<Backend>("vulkan"), std::invalid_argument);
 }
 
 TEST(RuntimeErrors, RefractorNeedsACurrentContext) {

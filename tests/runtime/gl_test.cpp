@@ -20,7 +20,7 @@ class GlTest : public test::HeadlessTest {
 protected:
     std::unique_ptr<Refractor> refractor(const Bake& bake, const std::string& preset = "modern") {
         RefractorOptions o;
-        o.preset = preset;
+        o.preset = parseName<ShaderPreset>(preset);
         o.loader = context_->loader();
         return Refractor::create(bake, o);
     }
@@ -47,7 +47,7 @@ TEST_P(GlTest, DecompressionEqualsCpuAtEveryMuSample) {
             for (glm::vec3 eye : {glm::vec3(0.3f, 0.8f, 3.0f), glm::vec3(-2.5f, -1.0f, 0.4f)}) {
                 float err = maxDecompressionError(*r, data, eye, order);
                 std::printf("[%s] order %d preset %s passes %d: max |GL - CPU| = %.3g\n",
-                            ToString(GetParam()), order, preset, r->passCount(), err);
+                            nameOf(GetParam()), order, preset, r->passCount(), err);
                 EXPECT_LT(err, 1e-4f) << preset << " order " << order;
             }
             // Progressive decompression: a lower order on the fly.
@@ -148,7 +148,7 @@ TEST_P(GlTest, RhoIsSeamlessWithCorrectionOnly) {
         SeamErrors off = seamErrors(*r, data.layout);
         std::printf("[%s] rate %d: seam error with correction %.3g, without %.3g; "
                     "vs interpolateRho %.3g\n",
-                    ToString(GetParam()), rate, on.seam, off.seam, on.vsCpu);
+                    nameOf(GetParam()), rate, on.seam, off.seam, on.vsCpu);
         EXPECT_LT(on.seam, 1e-5f);
         EXPECT_LT(on.vsCpu, 1e-5f);
         EXPECT_GT(off.seam, 1e-2f);
@@ -208,7 +208,7 @@ TEST_P(GlTest, RenderIsDeterministicCoversTheObjectAndFinite) {
     for (size_t i = 3; i < a.directions.size(); i += 4) covered += a.directions[i] > 0.5f;
     double coverage = double(covered) / (96 * 96);
     std::printf("[%s] coverage %.3f; GPU ms view %.3f decompress %.3f unpack %.3f shade %.3f\n",
-                ToString(GetParam()), coverage, a.timings.view, a.timings.decompress,
+                nameOf(GetParam()), coverage, a.timings.view, a.timings.decompress,
                 a.timings.unpack, a.timings.shade);
     EXPECT_EQ(nonFinite, 0u);
     EXPECT_GT(coverage, 0.15);
@@ -221,7 +221,7 @@ TEST_P(GlTest, RenderIsDeterministicCoversTheObjectAndFinite) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, GlTest, ::testing::Values(Backend::Egl, Backend::OSMesa),
-                         [](const auto& info) { return std::string(ToString(info.param)); });
+                         [](const auto& info) { return std::string(nameOf(info.param)); });
 
 }  // namespace
 }  // namespace shrefract
@@ -243,7 +243,7 @@ TEST_P(GlTest, HalfPrecisionBakesUseHalfTheWeightMemory) {
     EXPECT_EQ(r16->memory().weights * 2, r32->memory().weights);
     const glm::vec3 eye(0.3f, 0.8f, 3.0f);
     float err = maxDecompressionError(*r16, data, eye, 8);
-    std::printf("[%s] RGBA16F weights: max |GL - CPU| = %.3g\n", ToString(GetParam()), err);
+    std::printf("[%s] RGBA16F weights: max |GL - CPU| = %.3g\n", nameOf(GetParam()), err);
     EXPECT_LT(err, 0.05f);
     EXPECT_GT(err, 1e-6f);  // it really is half precision, not float
 }

@@ -16,7 +16,7 @@ protected:
         try {
             context_ = createHeadlessContext(GetParam(), 64, 64);
         } catch (const ContextError& e) {
-            GTEST_SKIP() << "no " << ToString(GetParam()) << " context: " << e.what();
+            GTEST_SKIP() << "no " << nameOf(GetParam()) << " context: " << e.what();
         }
     }
     std::unique_ptr<HeadlessContext> context_;

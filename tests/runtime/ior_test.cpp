@@ -44,9 +44,9 @@ protected:
     std::unique_ptr<Refractor> refractor(const BakeData& d) {
         RefractorOptions o;
         o.loader = context_->loader();
-        o.path = GetParam();
+        o.path = parseName<RefractorPath>(GetParam());
         auto r = Refractor::create(makeBake(d), o);
-        EXPECT_EQ(r->path(), GetParam());
+        EXPECT_EQ(nameOf(r->path()), std::string(GetParam()));
         return r;
     }
     RenderedFrame render(Refractor& r) {

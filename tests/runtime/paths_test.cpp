@@ -41,9 +41,9 @@ protected:
                                     const std::string& decompression = "auto",
                                     const std::string& shading = "sharp") {
         RefractorOptions o;
-        o.path = path;
-        o.decompression = decompression;
-        o.shading = shading;
+        o.path = parseName<RefractorPath>(path);
+        o.decompression = parseName<DecompressionSite>(decompression);
+        o.shading = parseName<Shading>(shading);
         o.loader = context_->loader();
         return Refractor::create(bake, o);
     }
@@ -90,9 +90,9 @@ TEST_P(Paths, DirectAndRhoGiveTheSameExitDirections) {
         for (const Camera& cam : {Camera::orbit(30, 20, 3.5f), Camera::orbit(200, -35, 2.8f)}) {
             auto rho = make(bake, "rho"), vertex = make(bake, "direct", "vertex"),
                  texture = make(bake, "direct", "texture");
-            EXPECT_EQ(rho->path(), "rho");
-            EXPECT_EQ(vertex->decompression(), "vertex");
-            EXPECT_EQ(texture->decompression(), "texture");
+            EXPECT_EQ(rho->path(), RefractorPath::Rho);
+            EXPECT_EQ(vertex->decompression(), DecompressionSite::Vertex);
+            EXPECT_EQ(texture->decompression(), DecompressionSite::Texture);
             const RenderedFrame fr = renderFrame(*rho, env, cam, 96, 96);
             const RenderedFrame fv = renderFrame(*vertex, env, cam, 96, 96);
             const RenderedFrame ft = renderFrame(*texture, env, cam, 96, 96);
@@ -100,7 +100,7 @@ TEST_P(Paths, DirectAndRhoGiveTheSameExitDirections) {
                            vt = compareDirections(fv, ft);
             std::printf("[%s] rate %d: direct/vertex vs rho max %.4f mean %.5f deg over %zu px, mismatch "
                         "%zu; direct/texture vs rho max %.4f; vertex vs texture max %.2g deg\n",
-                        ToString(GetParam()), rate, vr.maxDeg, vr.meanDeg, vr.both, vr.mismatch, tr.maxDeg,
+                        nameOf(GetParam()), rate, vr.maxDeg, vr.meanDeg, vr.both, vr.mismatch, tr.maxDeg,
                         vt.maxDeg);
             EXPECT_GT(vr.both, 1000u);
             EXPECT_LT(vt.maxDeg, 0.1);
@@ -140,8 +140,8 @@ TEST_P(Paths, EightBitWeightsStayEightBitOnTheGpu) {
     fs::create_directories(dir);
     BakeData data = test::randomBake(8, 2);
     data.precision = Precision::U8;
-    writeBake((dir / ("u8_" + std::string(ToString(GetParam())) + ".shrefract.exr")).string(), data);
-    const BakeData read = readBake((dir / ("u8_" + std::string(ToString(GetParam())) + ".shrefract.exr")).string());
+    writeBake((dir / ("u8_" + std::string(nameOf(GetParam())) + ".shrefract.exr")).string(), data);
+    const BakeData read = readBake((dir / ("u8_" + std::string(nameOf(GetParam())) + ".shrefract.exr")).string());
     Bake bake = makeBake(read);
     const glm::vec3 eye(0.3f, 0.8f, 3.0f);
     for (const char* dec : {"vertex", "texture"}) {
@@ -153,7 +153,7 @@ TEST_P(Paths, EightBitWeightsStayEightBitOnTheGpu) {
             const glm::vec4 cpu = decompressSample(read, i, localViewFromEye(read.layout, i, eye));
             for (int c = 0; c < 4; ++c) worst = std::max(worst, std::abs(gl[4 * i + c] - cpu[c]));
         }
-        std::printf("[%s] u8 as RGBA8, %s decompression: max |GL - CPU| = %.3g\n", ToString(GetParam()), dec, worst);
+        std::printf("[%s] u8 as RGBA8, %s decompression: max |GL - CPU| = %.3g\n", nameOf(GetParam()), dec, worst);
         EXPECT_LT(worst, 1e-4f) << dec;
         const size_t texels = size_t(read.layout.muWidth) * read.layout.muHeight;
         EXPECT_EQ(r->memory().weights, size_t(shEvenCount(8)) * texels * 4);
@@ -197,11 +197,11 @@ TEST_P(Paths, MemoryIsReportedPerPart) {
 // crossover on llvmpipe, docs/runtime.md); "vertex" asked for holds at any order.
 TEST_P(Paths, AutoDecompressionFollowsTheOrder) {
     const Bake high = makeBake(test::randomBake(4, 2));
-    EXPECT_EQ(make(high, "direct")->decompression(), "texture");
-    EXPECT_EQ(make(high, "direct", "vertex")->decompression(), "vertex");
+    EXPECT_EQ(make(high, "direct")->decompression(), DecompressionSite::Texture);
+    EXPECT_EQ(make(high, "direct", "vertex")->decompression(), DecompressionSite::Vertex);
     auto r = make(high, "direct");
     r->setOrder(1);
-    EXPECT_EQ(r->decompression(), "vertex");
+    EXPECT_EQ(r->decompression(), DecompressionSite::Vertex);
 }
 
 // Smoothing needs D_mu in texture space: turned on, the vertex-decompressing direct path switches
@@ -211,10 +211,12 @@ TEST_P(Paths, SmoothingSwitchesVertexDecompressionToTextureSpace) {
     Environment env = Environment::fromLatLong(64, 32, sky(64, 32));
     auto r = make(bake, "direct");
     const Camera cam = Camera::orbit(30, 20, 3.5f);
-    EXPECT_EQ(r->decompression(), "vertex");
+    EXPECT_EQ(r->decompression(), DecompressionSite::Vertex);
     const RenderedFrame plain = renderFrame(*r, env, cam, 96, 96);
     r->setSmoothing(true);
-    EXPECT_EQ(r->decompression(), "texture");
+    EXPECT_EQ(r->decompression(), DecompressionSite::Texture);
+    EXPECT_FALSE(r->timingsEnabled());  // off unless asked for: they stall every stage
+    r->setTimings(true);
     const RenderedFrame smooth = renderFrame(*r, env, cam, 96, 96);
     EXPECT_GT(r->timings().smooth, 0.0);
     EXPECT_GT(compareDirections(plain, smooth).maxDeg, 1.0);  // smoothing changed the directions
@@ -246,7 +248,7 @@ TEST_P(Paths, SpreadLookupMatchesItsCpuTwin) {
             for (int c = 0; c < 3; ++c) data.weights[i * 4 + c] = R * e[c] / y00;
         RefractorOptions o;
         o.loader = context_->loader();
-        o.shading = "spread";
+        o.shading = Shading::Spread;
         o.footprintScale = 0.0f;
         auto r = Refractor::create(makeBake(data), o);
         const RenderedFrame f = renderFrame(*r, env, Camera::orbit(30, 20, 3.5f), 48, 48);
@@ -270,7 +272,7 @@ TEST_P(Paths, SpreadLookupMatchesItsCpuTwin) {
             ++covered;
             for (int c = 0; c < 3; ++c) worst = std::max(worst, double(std::abs(f.color[i + c] - expect[c]) / expect[c]));
         }
-        std::printf("[%s] R %.2f: lod %.2f, max relative |GL - CPU| %.2g over %zu px\n", ToString(GetParam()), R,
+        std::printf("[%s] R %.2f: lod %.2f, max relative |GL - CPU| %.2g over %zu px\n", nameOf(GetParam()), R,
                     lodForSigma(sigma, env.faceSize(), env.levels()), worst, covered);
         EXPECT_GT(covered, 100u);
         EXPECT_LT(worst, 3e-3) << "R " << R;
@@ -278,7 +280,7 @@ TEST_P(Paths, SpreadLookupMatchesItsCpuTwin) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, Paths, ::testing::Values(Backend::Egl, Backend::OSMesa),
-                         [](const auto& info) { return std::string(ToString(info.param)); });
+                         [](const auto& info) { return std::string(nameOf(info.param)); });
 
 }  // namespace
 }  // namespace shrefract

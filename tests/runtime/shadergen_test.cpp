@@ -31,7 +31,7 @@ TEST(ShaderGen, EveryFunctionOnceAndWithinLimits) {
     for (ShForm form : {ShForm::Polynomial, ShForm::Recurrence})
     for (const char* preset : {"2006", "modern"}) {
         for (int L = 0; L <= 10; ++L) {
-            ShaderLimits limits = shaderPreset(preset);
+            ShaderLimits limits = shaderPreset(parseName<ShaderPreset>(preset));
             DecompressionShaders s = generateDecompression(L, limits, form);
             EXPECT_EQ(s.form, form);
             std::multiset<int> seen;
@@ -57,10 +57,10 @@ TEST(ShaderGen, EveryFunctionOnceAndWithinLimits) {
 }
 
 TEST(ShaderGen, TooSmallLimitsAreRefused) {
-    ShaderLimits tiny = shaderPreset("2006");
+    ShaderLimits tiny = shaderPreset(ShaderPreset::Paper2006);
     tiny.maxAluInstructions = 3;
     EXPECT_THROW(generateDecompression(4, tiny), std::invalid_argument);
-    EXPECT_THROW(shaderPreset("2042"), std::invalid_argument);
+    EXPECT_THROW(parseName<ShaderPreset>("2042"), std::invalid_argument);
 }
 
 // Compiles every generated pass with glslangValidator as GLSL 3.30 core and 4.50.
@@ -73,11 +73,11 @@ TEST(ShaderGen, GeneratedGlslCompiles) {
     for (const char* version : {"330 core", "450"})
         for (const char* preset : {"2006", "modern"})
             for (int L : {0, 2, 5, 8}) {
-                ShaderLimits limits = shaderPreset(preset);
+                ShaderLimits limits = shaderPreset(parseName<ShaderPreset>(preset));
                 limits.version = version;
                 DecompressionShaders s = generateDecompression(L, limits, form);
                 fs::path sub = dir / (std::string(preset) + "_" + std::to_string(L) + "_" +
-                                      std::string(version).substr(0, 3) + "_" + ToString(form));
+                                      std::string(version).substr(0, 3) + "_" + nameOf(form));
                 dumpShaders(s, sub.string());
                 std::vector<std::string> files = {(sub / "decompress.vert").string()};
                 for (size_t i = 0; i < s.passes.size(); ++i)
@@ -93,7 +93,7 @@ TEST(ShaderGen, GeneratedGlslCompiles) {
 // SHREFRACT_UPDATE_SNAPSHOTS=1 after an intended change, and read the diff.
 TEST(ShaderGen, SnapshotOrder2) {
     for (const char* preset : {"2006", "modern"}) {
-        std::string text = concatenated(generateDecompression(2, shaderPreset(preset)));
+        std::string text = concatenated(generateDecompression(2, shaderPreset(parseName<ShaderPreset>(preset))));
         std::string path = std::string(SHREFRACT_SNAPSHOT_DIR) + "/decompress_order2_" + preset + ".glsl";
         const char* update = std::getenv("SHREFRACT_UPDATE_SNAPSHOTS");
         if (update && std::string(update) == "1") {

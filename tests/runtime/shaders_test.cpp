@@ -80,7 +80,7 @@ TEST(ShaderFiles, EveryStageCompiles) {
         std::string text = shaders::source(name);
         if (name == "error_fold.frag")
             text = shaders::fill(text, "#pragma shrefract_generated",
-                                 generateDecompression(limits::kMaxErrorOrder, shaderPreset("modern"),
+                                 generateDecompression(limits::kMaxErrorOrder, shaderPreset(ShaderPreset::Modern),
                                                        ShForm::Polynomial).passes[0].generated);
         std::ofstream(f, std::ios::binary) << text;
         const std::string cmd = std::string(SHREFRACT_GLSLANG) + " " + f.string() + " > " +

@@ -65,7 +65,7 @@ protected:
         try {
             context_ = createHeadlessContext(GetParam(), kColumns, 3);
         } catch (const ContextError& e) {
-            GTEST_SKIP() << "no " << ToString(GetParam()) << " context: " << e.what();
+            GTEST_SKIP() << "no " << nameOf(GetParam()) << " context: " << e.what();
         }
     }
     std::unique_ptr<HeadlessContext> context_;
@@ -127,11 +127,11 @@ TEST_P(ShadingGlsl, FresnelAbsorptionAndToneMapMatchTheirClosedForms) {
         }
     }
     std::printf("[%s] max |GPU - closed form|: Fresnel %.2g, tone map %.2g, absorption %.2g\n",
-                ToString(GetParam()), worstF, worstT, worstA);
+                nameOf(GetParam()), worstF, worstT, worstA);
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, ShadingGlsl, ::testing::Values(Backend::Egl, Backend::OSMesa),
-                         [](const auto& info) { return std::string(ToString(info.param)); });
+                         [](const auto& info) { return std::string(nameOf(info.param)); });
 
 }  // namespace
 }  // namespace shrefract

@@ -37,11 +37,11 @@ protected:
     test::FormError error(const BakeData& data, const std::string& form, std::string* used = nullptr,
                           const std::string& preset = "modern") {
         RefractorOptions o;
-        o.preset = preset;
-        o.form = form;
+        o.preset = parseName<ShaderPreset>(preset);
+        o.form = parseName<ShForm>(form);
         o.loader = context_->loader();
         auto r = Refractor::create(makeBake(data), o);
-        if (used) *used = r->form();
+        if (used) *used = nameOf(r->form());
         return test::measureFormError(*r, data, test::formErrorEyes());
     }
     std::unique_ptr<HeadlessContext> context_;
@@ -114,7 +114,7 @@ TEST_F(ShFormTest, RecurrenceUnder2006LimitsMatchesTheReference) {
 // than 64, while the recurrence fits through order 16 (auto takes it there); from 17 on the
 // powers (x + iy)^2..L that y_L^L needs exceed 64 alone, and neither form fits.
 TEST(ShFormGen, Preset2006Limits) {
-    ShaderLimits r300 = shaderPreset("2006");
+    ShaderLimits r300 = shaderPreset(ShaderPreset::Paper2006);
     EXPECT_THROW(generateDecompression(16, r300, ShForm::Polynomial), std::invalid_argument);
     DecompressionShaders s = generateDecompression(16, r300, ShForm::Auto);
     EXPECT_EQ(s.form, ShForm::Recurrence);
@@ -126,8 +126,8 @@ TEST(ShFormGen, Preset2006Limits) {
         std::printf("2006, order %d: %zu passes polynomial, %zu recurrence\n", L, poly, rec);
         EXPECT_LE(rec, poly);
     }
-    EXPECT_EQ(parseShForm("recurrence"), ShForm::Recurrence);
-    EXPECT_THROW(parseShForm("chebyshev"), std::invalid_argument);
+    EXPECT_EQ(parseName<ShForm>("recurrence"), ShForm::Recurrence);
+    EXPECT_THROW(parseName<ShForm>("chebyshev"), std::invalid_argument);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,11 @@ enum class BaselineMethod {
     Single,  // refract once at the front surface, look up the environment
     Wyman,   // Wyman 2005: second interface from a back-face normal/depth pass
 };
+template <> struct EnumNames<BaselineMethod> {
+    static constexpr const char* what = "baseline method";
+    static constexpr NamedValue<BaselineMethod> table[] = {{BaselineMethod::Single, "single"},
+                                                           {BaselineMethod::Wyman, "wyman"}};
+};
 
 // Wyman's slides list three answers to total internal reflection at the second interface.
 enum class WymanTir {
@@ -23,13 +29,22 @@ enum class WymanTir {
     Straight,  // continue along T1
     Grazing,   // refract at the critical angle: T1 projected onto the back surface's plane
 };
+template <> struct EnumNames<WymanTir> {
+    static constexpr const char* what = "Wyman TIR rule";
+    static constexpr NamedValue<WymanTir> table[] = {{WymanTir::Reflect, "reflect"},
+                                                     {WymanTir::Straight, "straight"},
+                                                     {WymanTir::Grazing, "grazing"}};
+};
 
 struct BaselineOptions {
     BaselineMethod method = BaselineMethod::Wyman;
     WymanTir tir = WymanTir::Reflect;
-    bool timings = true;                     // GL timer queries around each pass
+    bool timings = false;                    // GL timer queries around each pass (they stall)
     bool toneMap = false;                    // draw display values (toneMap()) instead of HDR
     float exposure = 1.0f;
+    // Absorption kappa per RGB channel and object-space unit, instead of the bake's media
+    // (Bake::absorption()): tinted glass without re-baking, as the paths do not depend on it.
+    std::optional<glm::vec3> absorption;
     void* (*loader)(const char*) = nullptr;  // GL function loader; nullptr: guess from context
 };
 
@@ -54,6 +69,8 @@ public:
     void draw(const glm::mat4& view, const glm::mat4& projection, const glm::mat4& model,
               const Environment& environment);
     const BaselineTimings& timings() const;
+    void setTimings(bool on);  // GL timer queries per pass (BaselineOptions::timings)
+    bool timingsEnabled() const;
 
     struct Impl;
 
@@ -61,9 +78,5 @@ private:
     explicit Baseline(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> impl_;
 };
-
-// "single" | "wyman", "reflect" | "straight" | "grazing"; throw std::invalid_argument otherwise.
-BaselineMethod parseBaselineMethod(const std::string& text);
-WymanTir parseWymanTir(const std::string& text);
 
 }  // namespace shrefract

@@ -5,9 +5,15 @@
 #include <stdexcept>
 #include <string>
 
+#include "shrefract/enum_names.h"
+
 namespace shrefract {
 
 enum class Backend { Egl, OSMesa };
+template <> struct EnumNames<Backend> {
+    static constexpr const char* what = "GL backend";
+    static constexpr NamedValue<Backend> table[] = {{Backend::Egl, "egl"}, {Backend::OSMesa, "osmesa"}};
+};
 
 // No context could be made (library missing, driver refused): the message says which and why.
 struct ContextError : std::runtime_error {
@@ -33,8 +39,5 @@ public:
 // platform, no surface. OSMesa: libOSMesa loaded at run time. Throws ContextError.
 std::unique_ptr<HeadlessContext> createHeadlessContext(Backend backend, int width = 16,
                                                        int height = 16);
-// "egl" | "osmesa"; throws std::invalid_argument otherwise.
-Backend parseBackend(const std::string& text);
-const char* ToString(Backend backend);
 
 }  // namespace shrefract

@@ -5,10 +5,13 @@
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
+
+#include "shrefract/enum_names.h"
 
 namespace shrefract {
 
@@ -111,25 +114,81 @@ struct GpuMemory {
     size_t total() const { return weights + samples + rho + neighbours + mesh + targets; }
 };
 
+// The shader limits the generated passes fit (docs/runtime.md "Shader presets"): Modern is one
+// pass with the weights in a texture array; Paper2006 is the paper's ATI R300 class (16 samplers,
+// 64 ALU instructions per pass, no vertex texture fetch).
+enum class ShaderPreset { Modern, Paper2006 };
+template <> struct EnumNames<ShaderPreset> {
+    static constexpr const char* what = "shader preset";
+    static constexpr NamedValue<ShaderPreset> table[] = {{ShaderPreset::Modern, "modern"},
+                                                         {ShaderPreset::Paper2006, "2006"}};
+};
+
+// How the generated passes evaluate the SH functions: Polynomial (expanded Cartesian
+// polynomials, the paper's), Recurrence (associated Legendre recurrence: fewer float32 digits
+// lost at high orders) or Auto (the recurrence from the measured switch order on; docs/runtime.md
+// "Polynomial vs recurrence").
+enum class ShForm { Polynomial, Recurrence, Auto };
+template <> struct EnumNames<ShForm> {
+    static constexpr const char* what = "SH form";
+    static constexpr NamedValue<ShForm> table[] = {{ShForm::Polynomial, "polynomial"},
+                                                   {ShForm::Recurrence, "recurrence"},
+                                                   {ShForm::Auto, "auto"}};
+};
+
+// How the refraction map is interpolated across triangles (docs/runtime.md "Interpolation
+// paths"): Rho is the paper's texture-space layout with correction texels and an unpack pass;
+// Direct draws the sample grid as a refined mesh and lets the rasterizer interpolate; Charts is
+// the isolated-surface pipeline of chart bakes (paper §5.2, Figure 6).
+enum class RefractorPath { Auto, Rho, Direct, Charts };
+template <> struct EnumNames<RefractorPath> {
+    static constexpr const char* what = "path";
+    static constexpr NamedValue<RefractorPath> table[] = {{RefractorPath::Auto, "auto"},
+                                                          {RefractorPath::Rho, "rho"},
+                                                          {RefractorPath::Direct, "direct"},
+                                                          {RefractorPath::Charts, "charts"}};
+};
+
+// Direct path: where the SH are evaluated. Vertex: in the shading pass's vertex shader (one
+// draw; needs a one-pass preset and no smoothing); Texture: decompression passes into D_mu first.
+enum class DecompressionSite { Auto, Vertex, Texture };
+template <> struct EnumNames<DecompressionSite> {
+    static constexpr const char* what = "decompression";
+    static constexpr NamedValue<DecompressionSite> table[] = {{DecompressionSite::Auto, "auto"},
+                                                              {DecompressionSite::Vertex, "vertex"},
+                                                              {DecompressionSite::Texture, "texture"}};
+};
+
+// How the exit direction becomes a colour where the bake is unsure of it (its error model
+// predicts an error, or, without one, the SH reconstruction is short), with a lobe
+// RefractorOptions::spreadScale times that wide:
+//   Jitter (the default): one direction drawn from the lobe, stable on the object, looked up over
+//     the pixel's footprint: keeps the contrast the truth has;
+//   Spread: the environment averaged over the lobe (a prefiltered cube map), widened by the
+//     footprint: the lobe's mean;
+//   Blend: the sharp lookup and the spread lobe mixed by the lobe's width;
+//   Sharp: the paper's single lookup along the exit direction.
+// The default follows scripts/study-shading (object FLIP, detail ratio; docs/runtime.md).
+enum class Shading { Jitter, Spread, Blend, Sharp };
+template <> struct EnumNames<Shading> {
+    static constexpr const char* what = "shading";
+    static constexpr NamedValue<Shading> table[] = {{Shading::Jitter, "jitter"},
+                                                    {Shading::Spread, "spread"},
+                                                    {Shading::Blend, "blend"},
+                                                    {Shading::Sharp, "sharp"}};
+};
+
 struct RefractorOptions {
-    std::string preset = "modern";  // shader limits: "modern" or "2006" (runtime/src/shadergen.h)
-    // How the generated passes evaluate the SH functions: "polynomial" (expanded Cartesian
-    // polynomials, the paper's), "recurrence" (associated Legendre recurrence: fewer float32
-    // digits lost at high orders) or "auto" (the recurrence from the measured switch order on;
-    // docs/runtime.md "Polynomial vs recurrence"). Where the recurrence does not fit the
-    // preset's limits ("2006" above order 16), "auto" uses the polynomial and "recurrence"
-    // throws std::invalid_argument.
-    std::string form = "auto";
-    // How the refraction map is interpolated across triangles (docs/runtime.md "Interpolation
-    // paths"): "rho" is the paper's texture-space layout with correction texels and an unpack
-    // pass; "direct" draws the sample grid as a refined mesh and lets the rasterizer interpolate;
-    // "auto": direct for the modern preset, rho for 2006. Chart bakes (isolated, uv) take their
-    // own path, "charts" (paper §5.2, Figure 6): "auto" or "charts" there, anything else throws.
-    std::string path = "auto";
-    // Direct path: where the SH are evaluated. "vertex": in the shading pass's vertex shader (one
-    // draw; needs a one-pass preset and no smoothing); "texture": decompression passes into D_mu
-    // first; "auto": the measured default (docs/runtime.md).
-    std::string decompression = "auto";
+    ShaderPreset preset = ShaderPreset::Modern;
+    // Where the recurrence does not fit the preset's limits (Paper2006 above order 16), Auto uses
+    // the polynomial and Recurrence throws std::invalid_argument.
+    ShForm form = ShForm::Auto;
+    // Auto: Direct where the preset fetches textures in the vertex shader (Modern), Rho where it
+    // cannot (Paper2006); Charts for chart bakes (isolated, uv), which take no other path
+    // (std::invalid_argument).
+    RefractorPath path = RefractorPath::Auto;
+    // Auto: the measured default (docs/runtime.md "Interpolation paths").
+    DecompressionSite decompression = DecompressionSite::Auto;
     int order = -1;                 // SH order used, -1: all uploaded; above maxOrder clamps
                                     // to it (order() tells); below -1: std::invalid_argument
     int maxOrder = -1;              // bands uploaded to the GPU, 0..maxOrder (-1: all stored);
@@ -139,22 +198,13 @@ struct RefractorOptions {
     bool halfWeights = false;
     bool smoothing = false;         // spatial smoothing through the bake's neighbour lists
     bool correction = true;         // interpolation-correction texels in rho (paper §5.3.1)
-    // Where the bake is unsure of the exit (its error model predicts an error, or, without one,
-    // the SH reconstruction is short), a lobe spreadScale times that wide:
-    // "jitter" (the default): one direction drawn from the lobe, stable on the object, looked up
-    //   over the pixel's footprint: keeps the contrast the truth has;
-    // "spread": the environment averaged over the lobe (a prefiltered cube map), widened by the
-    //   footprint: the lobe's mean;
-    // "blend": the sharp lookup and the spread lobe mixed by the lobe's width;
-    // "sharp": the paper's single lookup along the exit direction.
-    // The defaults follow scripts/study-shading (object FLIP, detail ratio; docs/runtime.md).
-    std::string shading = "jitter";
+    Shading shading = Shading::Jitter;
     float spreadScale = 0.15f;      // lobe width factor on the predicted error (docs/runtime.md)
     float footprintScale = 0.15f;   // screen-space footprint factor
-    // "blend": the sharp lookup and the spread lobe mixed, the lobe's share sigma / (sigma +
+    // Blend: the sharp lookup and the spread lobe mixed, the lobe's share sigma / (sigma +
     // blendSigma) for a lobe sigma radians wide (docs/runtime.md "Blend shading").
     float blendSigma = 0.1f;
-    // "jitter": one direction drawn from the spread lobe per cell of this size (a fraction of the
+    // Jitter: one direction drawn from the spread lobe per cell of this size (a fraction of the
     // object's bounding-box diagonal; about two pixels where the object spans 400), the same in
     // every frame, instead of the lobe's mean (docs/runtime.md "Jitter shading").
     float jitterCell = 0.005f;
@@ -168,9 +218,14 @@ struct RefractorOptions {
     // take the values across the cut instead (seam-aware filling, docs/runtime.md).
     int gutter = -1;
     bool seamAware = true;
-    bool timings = true;            // GL timer queries around every stage
+    // GL timer queries around every stage, read through timings(). Off by default: each timed
+    // stage waits for the GPU (docs/runtime.md "Benchmark"), so frames with them on stall.
+    bool timings = false;
     bool toneMap = false;           // draw() writes display values (toneMap()) instead of HDR
     float exposure = 1.0f;
+    // Absorption kappa per RGB channel and object-space unit, instead of the bake's media
+    // (Bake::absorption()): tinted glass without re-baking, as the paths do not depend on it.
+    std::optional<glm::vec3> absorption;
     void* (*loader)(const char*) = nullptr;  // GL function loader; nullptr: guess from context
 };
 
@@ -191,8 +246,8 @@ public:
     // request (rho index and target allocated then) and kept up to date by every later update().
     unsigned refractionMap();
     glm::ivec2 refractionMapSize() const;
-    std::string path() const;           // "rho", "direct", or "charts" for chart bakes
-    std::string decompression() const;  // "texture" or "vertex"
+    RefractorPath path() const;               // Rho, Direct, or Charts for chart bakes
+    DecompressionSite decompression() const;  // Texture or Vertex
     // Progressive decompression (paper §6): use bands 0..L, as RefractorOptions::order does:
     // -1 is all uploaded bands, above maxOrder clamps to it, below -1 is std::invalid_argument.
     void setOrder(int L);
@@ -218,10 +273,11 @@ public:
     void setIorBracket(Refractor* other);
     // GL timer queries per stage (RefractorOptions::timings); off zeroes timings().
     void setTimings(bool on);
+    bool timingsEnabled() const;
     const Timings& timings() const;
     int passCount() const;  // decompression passes at the current order
-    // The SH evaluation form of the current order's passes: "polynomial" or "recurrence".
-    std::string form() const;
+    // The SH evaluation form of the current order's passes: Polynomial or Recurrence.
+    ShForm form() const;
     const GpuMemory& memory() const;
     // Writes the generated GLSL of the current order into `dir`.
     void dumpShaders(const std::string& dir) const;

@@ -1,0 +1,42 @@
+#include "rho_pipeline.h"
+
+#include "ior.h"
+
+namespace shrefract {
+
+using namespace gl;
+
+RhoPipeline::RhoPipeline(const PipelineInputs& in)
+    : settings_(in.settings),
+      grid_(in.bake.data().layout, in.memory),
+      decompression_(in.bake.data(), in.options, in.maxOrder, in.limits, in.form, grid_, in.memory),
+      map_(in.bake.data().layout, in.memory),
+      mesh_(in.bake, in.memory) {
+    prepare();
+}
+
+int RhoPipeline::passCount() {
+    return static_cast<int>(decompression_.compiled(settings_.order).programs.size());
+}
+
+void RhoPipeline::update(glm::vec3 eyeObject, bool, const StageClock& clock) {
+    const GLuint d = decompression_.run(eyeObject, settings_.order, settings_.smoothing, clock);
+    map_.unpack(d, settings_.correction, clock);
+    ready_ = true;
+}
+
+GLuint RhoPipeline::shadingProgram(IorShading* ior) {
+    return ior ? ior->program(false, decompression_.muWidth()) : mesh_.program();
+}
+
+void RhoPipeline::draw(GLuint, bool, glm::vec3) { mesh_.draw(map_.texture()); }
+
+GLuint RhoPipeline::refractionMap() {
+    if (!ready_) {  // before the first update(): whatever D_mu holds
+        map_.unpack(decompression_.result(), settings_.correction, {});
+        ready_ = true;
+    }
+    return map_.texture();
+}
+
+}  // namespace shrefract

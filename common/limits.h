@@ -1,6 +1,6 @@
 // The ranges every way into a bake accepts, in one place: shrefract-bake's options, a scene file's
-// media, and the manifest of a bake file read back (common/format.cpp). What the bake refuses to
-// make, the reader refuses to load.
+// media, and the manifest of a bake file read back (manifestProblem, common/bake_validate.cpp).
+// What the bake refuses to make, the reader refuses to load.
 #pragma once
 
 namespace shrefract::limits {

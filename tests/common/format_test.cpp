@@ -15,9 +15,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <functional>
-#include <iterator>
 #include <map>
 #include <random>
 #include <string>
@@ -28,6 +26,7 @@
 #include "common/checksum.h"
 #include "common/error.h"
 #include "common/sh.h"
+#include "support/files.h"
 
 namespace shrefract {
 namespace {
@@ -37,30 +36,16 @@ using nlohmann::json;
 
 // A scratch folder per test, so that tests may run in parallel and "no temporary file is left"
 // looks only at this test's files.
-fs::path scratch() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    const fs::path dir = fs::path(SHREFRACT_TEST_TMP) / "format" / info->name();
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
+fs::path scratch() { return test::scratchFolder("format"); }
 
-std::string readBytes(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using test::readFile;
+using test::writeFile;
 
-void writeBytes(const fs::path& p, const std::string& bytes) {
-    std::ofstream out(p, std::ios::binary);
-    out << bytes;
-}
-
+// The temporary files of writes (writeAtomically) left in `dir`, sorted.
 std::vector<std::string> leftovers(const fs::path& dir) {
     std::vector<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir)) {
-        const std::string name = e.path().filename().string();
+    for (const std::string& name : test::listing(dir))
         if (name.find(".shrefract-tmp.") != std::string::npos) names.push_back(name);
-    }
     return names;
 }
 
@@ -634,7 +619,7 @@ TEST(Format, MissingFileIsReported) {
 
 TEST(Format, NonExrFileIsReported) {
     const fs::path path = scratch() / "text.shrefract.exr";
-    writeBytes(path, "this is a text file, not an image\n");
+    writeFile(path, "this is a text file, not an image\n");
     expectInputError(path, "not an OpenEXR file");
 }
 
@@ -666,8 +651,8 @@ TEST(Format, NewerVersionIsRejected) {
 TEST(Format, TruncatedFileIsReported) {
     const fs::path dir = scratch();
     writeBake((dir / "ok.shrefract.exr").string(), syntheticBake(Precision::F32));
-    const std::string bytes = readBytes(dir / "ok.shrefract.exr");
-    writeBytes(dir / "half.shrefract.exr", bytes.substr(0, bytes.size() / 2));
+    const std::string bytes = readFile(dir / "ok.shrefract.exr");
+    writeFile(dir / "half.shrefract.exr", bytes.substr(0, bytes.size() / 2));
     expectInputError(dir / "half.shrefract.exr", "");
 }
 
@@ -843,7 +828,7 @@ TEST(Format, FailedWriteLeavesOldFileUntouched) {
     const fs::path dir = scratch();
     const fs::path path = dir / "bake.shrefract.exr";
     writeBake(path.string(), syntheticBake(Precision::F32, 1));
-    const std::string before = readBytes(path);
+    const std::string before = readFile(path);
 
     // Caught before the temporary file is opened: sizes that do not agree.
     BakeData sizes = syntheticBake(Precision::F32, 2);
@@ -852,19 +837,19 @@ TEST(Format, FailedWriteLeavesOldFileUntouched) {
     BakeData rho = syntheticBake(Precision::F32, 2);
     rho.layout.rho[5] = {RhoTexel::Sample, 1000, 0, 0};
     EXPECT_THROW(writeBake(path.string(), rho), std::invalid_argument);
-    EXPECT_EQ(readBytes(path), before);
+    EXPECT_EQ(readFile(path), before);
 
     // Caught midway, with the temporary file half written: a NaN weight in the last sample.
     BakeData nan = syntheticBake(Precision::F32, 2);
     nan.weights.back() = NAN;
     EXPECT_THROW(writeBake(path.string(), nan), std::invalid_argument);
-    EXPECT_EQ(readBytes(path), before);
+    EXPECT_EQ(readFile(path), before);
     EXPECT_EQ(leftovers(dir), std::vector<std::string>{});
 
     // U8 finds it while fitting the scales.
     nan.precision = Precision::U8;
     EXPECT_THROW(writeBake(path.string(), nan), std::invalid_argument);
-    EXPECT_EQ(readBytes(path), before);
+    EXPECT_EQ(readFile(path), before);
     EXPECT_EQ(leftovers(dir), std::vector<std::string>{});
 }
 
@@ -1054,7 +1039,7 @@ TEST(Format, RandomCorruptionIsRefusedOrHarmless) {
     for (Precision precision : {Precision::F32, Precision::U8}) {
         writeBake(ok.string(), syntheticBake(precision));
         const BakeData original = readBake(ok.string());
-        const std::string bytes = readBytes(ok);
+        const std::string bytes = readFile(ok);
         std::mt19937 rng(precision == Precision::F32 ? 1 : 2);
         int refused = 0, harmless = 0, truncations = 0;
         for (int trial = 0; trial < 500; ++trial) {
@@ -1070,7 +1055,7 @@ TEST(Format, RandomCorruptionIsRefusedOrHarmless) {
                 }
             }
             const fs::path bad = dir / "bad.shrefract.exr";
-            writeBytes(bad, damaged);
+            writeFile(bad, damaged);
             try {
                 const BakeData d = readBake(bad.string());
                 EXPECT_TRUE(sameData(d, original)) << "trial " << trial << " loaded different data";

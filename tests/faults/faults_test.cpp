@@ -49,10 +49,7 @@ fs::path scratch() {
 
 using test::listing;
 using test::readFile;
-
-void writeFile(const fs::path& p, const std::string& bytes) {
-    std::ofstream(p, std::ios::binary) << bytes;
-}
+using test::writeFile;
 
 struct Child {
     pid_t pid = -1;

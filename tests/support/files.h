@@ -1,4 +1,5 @@
-// Small file helpers the tests share: a scratch folder per test, whole-file reads, listings.
+// Small file helpers the tests share: a scratch folder per test, whole-file reads and writes,
+// listings.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -26,6 +27,11 @@ inline std::string readFile(const std::filesystem::path& p) {
     std::stringstream ss;
     ss << f.rdbuf();
     return ss.str();
+}
+
+// `bytes` as the whole of `p` (a plain write, not writeAtomically: tests plant files with it).
+inline void writeFile(const std::filesystem::path& p, const std::string& bytes) {
+    std::ofstream(p, std::ios::binary) << bytes;
 }
 
 // Every name in `dir` (no recursion), sorted.

@@ -12,7 +12,7 @@
 
 #include <Eigen/Core>
 
-#include "bake/layout.h"
+#include "bake/joining_layout.h"
 #include "common/checksum.h"
 #include "common/error.h"
 #include "common/frame.h"

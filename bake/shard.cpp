@@ -14,7 +14,7 @@
 #include <set>
 #include <sstream>
 
-#include "bake/layout.h"
+#include "bake/joining_layout.h"
 #include "common/error.h"
 #include "common/limits.h"
 #include "common/sh.h"

@@ -9,7 +9,7 @@
 
 #include <Eigen/Core>
 
-#include "bake/layout.h"
+#include "bake/joining_layout.h"
 #include "common/decompress.h"
 #include "common/frame.h"
 #include "common/sh.h"

@@ -1,5 +1,6 @@
 // Addressing in the surface layouts (declared in common/bakefile.h). The layouts themselves are
-// built by the bake (bake/layout.cpp, bake/charts.cpp); these are the lookups everyone shares.
+// built by the bake (bake/joining_layout.cpp, bake/charts.cpp); these are the lookups
+// everyone shares.
 #include "common/bakefile.h"
 #include "common/error.h"
 

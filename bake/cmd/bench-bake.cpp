@@ -17,7 +17,7 @@
 
 #include "bake/bake.h"
 #include "bake/cmd/common_cli.h"
-#include "bake/layout.h"
+#include "bake/joining_layout.h"
 #include "common/cli/cli.h"
 #include "common/frame.h"
 #include "common/output.h"

@@ -7,7 +7,7 @@
 #include <filesystem>
 
 #include "bake/bake.h"
-#include "bake/layout.h"
+#include "bake/joining_layout.h"
 #include "bake/shard.h"
 #include "bake/target.h"
 #include "bake/cmd/common_cli.h"

@@ -12,7 +12,7 @@
 #include <random>
 
 #include "bake/fit.h"
-#include "bake/layout.h"
+#include "bake/joining_layout.h"
 #include "bake/tracer.h"
 #include "common/cli/cli.h"
 #include "common/direction_grid.h"

@@ -19,7 +19,7 @@
 
 #include "bake/bake.h"
 #include "eval/image_eval.h"
-#include "bake/layout.h"
+#include "bake/joining_layout.h"
 #include "eval/reference.h"
 #include "common/cli/cli.h"
 #include "common/latlong.h"

@@ -5,7 +5,7 @@
 
 #include <random>
 
-#include "bake/layout.h"
+#include "bake/joining_layout.h"
 #include "common/bakefile.h"
 #include "common/scene.h"
 #include "common/sh.h"

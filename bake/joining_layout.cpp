@@ -1,4 +1,4 @@
-#include "bake/layout.h"
+#include "bake/joining_layout.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 // Invariants of the joining-surfaces layout (paper §5.3, DESIGN §3).
-#include "bake/layout.h"
+#include "bake/joining_layout.h"
 
 #include <gtest/gtest.h>
 

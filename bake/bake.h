@@ -13,7 +13,7 @@
 #include <mutex>
 #include <string>
 
-#include "bake/charts.h"
+#include "bake/chart_layout.h"
 #include "bake/fit.h"
 #include "bake/residual.h"
 #include "bake/tracer.h"

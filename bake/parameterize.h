@@ -15,7 +15,7 @@ enum class ChartMethod { Lscm, Arap };
 const char* ToString(ChartMethod m);
 
 // One closed or open triangle mesh with vertices welded by position, and the chart of every
-// triangle. Every chart must be a topological disk (bake/charts.cpp checks that first).
+// triangle. Every chart must be a topological disk (bake/chart_unfold.cpp checks that first).
 struct ChartedMesh {
     std::vector<glm::dvec3> positions;
     std::vector<glm::uvec3> triangles;  // counter-clockwise seen from outside

@@ -1,5 +1,5 @@
 // Addressing in the surface layouts (declared in common/bakefile.h). The layouts themselves are
-// built by the bake (bake/joining_layout.cpp, bake/charts.cpp); these are the lookups
+// built by the bake (bake/joining_layout.cpp, bake/chart_layout.cpp); these are the lookups
 // everyone shares.
 #include "common/bakefile.h"
 #include "common/error.h"

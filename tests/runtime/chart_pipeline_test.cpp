@@ -8,7 +8,7 @@
 #include <cmath>
 #include <map>
 
-#include "bake/charts.h"
+#include "bake/chart_layout.h"
 #include "common/decompress.h"
 #include "common/error.h"
 #include "common/sh.h"

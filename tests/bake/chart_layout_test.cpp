@@ -1,8 +1,8 @@
-// Invariants of the chart layouts (paper §5.2, bake/charts.h), each checked on the layout the bake
-// writes by a separate, plain computation: topology from the unfolded mesh, injectivity by
+// Invariants of the chart layouts (paper §5.2, bake/chart_layout.h), each checked on the layout
+// the bake writes by a separate, plain computation: topology from the unfolded mesh, injectivity by
 // rasterizing every triangle on a finer grid, coverage by point-in-triangle tests, seam sources
 // by extrapolating the surface across the cut.
-#include "bake/charts.h"
+#include "bake/chart_layout.h"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
-// A bake at scale (DESIGN §8, docs/bake.md "Shards, checkpoints and schedulers"): the batches of
-// a bake cut into N deterministic slices. `shrefract-bake --shard I/N` bakes one slice into a
-// shard file on any machine; shrefract-merge checks that a set of shards makes one whole bake
-// and writes the file a single machine would have written, byte for byte in the weights. A long
-// single-machine bake checkpoints the same way, into a work folder, and resumes from it.
+// A bake at scale (docs/design.md#scale, docs/bake.md "Shards, checkpoints and schedulers"): the
+// batches of a bake cut into N deterministic slices. `shrefract-bake --shard I/N` bakes one slice
+// into a shard file on any machine; shrefract-merge checks that a set of shards makes one whole
+// bake and writes the file a single machine would have written, byte for byte in the weights. A
+// long single-machine bake checkpoints the same way, into a work folder, and resumes from it.
 #pragma once
 
 #include <functional>

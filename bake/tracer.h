@@ -1,4 +1,4 @@
-// The Embree tracer of refracted paths (DESIGN.md §3 "Path rules", docs/bake.md).
+// The Embree tracer of refracted paths (docs/design.md#path-rules, docs/bake.md "Path rules").
 #pragma once
 
 #include <cstdint>

@@ -1,4 +1,5 @@
-// Errors, in two channels (docs/conventions.md): CHECK for bugs, InputError (shrefract/error.h) for bad input.
+// Errors, in two channels (docs/design.md#errors): CHECK for bugs, InputError (shrefract/error.h)
+// for bad input.
 #pragma once
 
 #include <sstream>

@@ -1,5 +1,5 @@
-// The ground-truth renderer (DESIGN.md §5): per pixel, the path the bake would trace, on the CPU
-// with Embree, shaded exactly as the runtime shades (docs/evaluation.md "raytrace").
+// The ground-truth renderer (docs/design.md#evaluation): per pixel, the path the bake would trace,
+// on the CPU with Embree, shaded exactly as the runtime shades (docs/evaluation.md "raytrace").
 #pragma once
 
 #include <cstddef>

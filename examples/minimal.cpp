@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
         //    own instead, e.g. with GLFW:
         //      glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3); ... GLFW_OPENGL_CORE_PROFILE ...
         //      glfwMakeContextCurrent(window);
-        //    and passes `glfwGetProcAddress` as RefractorOptions::loader (runtime/cmd/
+        //    and passes `glfwGetProcAddress` as RefractorOptions::loader (eval/cmd/
         //    shrefract-view.cpp does exactly that).
         auto context = shrefract::createHeadlessContext(shrefract::Backend::Egl);
         std::printf("GL: %s\n", context->description().c_str());

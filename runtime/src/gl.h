@@ -133,7 +133,7 @@ private:
     GLint framebuffer_ = 0;
 };
 
-// GL error check that compiles out of release builds (STYLE.md).
+// GL error check that compiles out of release builds (docs/design.md#errors).
 #ifdef NDEBUG
 #define SHREFRACT_GL_CHECK() ((void)0)
 #else

@@ -1,4 +1,4 @@
-// Invariants of the joining-surfaces layout (paper §5.3, DESIGN §3).
+// Invariants of the joining-surfaces layout (paper §5.3, docs/design.md#surface-layouts).
 #include "bake/joining_layout.h"
 
 #include <gtest/gtest.h>

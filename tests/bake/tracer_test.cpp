@@ -1,4 +1,4 @@
-// The tracer on cases with known answers (DESIGN §3 path rules).
+// The tracer on cases with known answers (docs/design.md#path-rules).
 #include "bake/tracer.h"
 
 #include <gtest/gtest.h>
@@ -160,10 +160,10 @@ TEST(Tracer, NestedMediaResolvedByPriority) {
     EXPECT_EQ(r.bounces, 4);  // cavity top, water top, water bottom (into glass), glass bottom
 }
 
-// Equal priorities: the medium entered last is in effect (DESIGN §3, "ties: the most recently
-// entered"). A water slab (1.33) inside a glass slab (1.5), both priority 0: between the water's
-// faces the path is in water, so it bends there; if the glass, entered first, won the tie, the
-// water's faces would be no interfaces and the path would stay in glass.
+// Equal priorities: the medium entered last is in effect (docs/design.md#path-rules: ties go to the
+// most recently entered). A water slab (1.33) inside a glass slab (1.5), both priority 0: between
+// the water's faces the path is in water, so it bends there; if the glass, entered first, won the
+// tie, the water's faces would be no interfaces and the path would stay in glass.
 TEST(Tracer, EqualPrioritiesGoToTheMediumEnteredLast) {
     Scene s = sceneOf(flatBox({-5, -5, -1}, {5, 5, 1}), 1.5, /*priority=*/0);
     Part water;
@@ -208,10 +208,10 @@ TEST(Tracer, FresnelBranchReflectsAndSoftCapEndsThePath) {
     EXPECT_FALSE(f.flags & kPathCapped);
 }
 
-// The branch threshold is F = 1/2 exactly (DESIGN §3 rule 2: the larger branch). In a wide slab
-// of glass the ray meets the bottom face at the refraction angle; aim it so that the Fresnel
-// reflectance there (closed form from the angles, in double, independent of optics.h) is 0.45,
-// then 0.55. At 0.45 it leaves through the bottom at once, along its entry direction; at 0.55 it
+// The branch threshold is F = 1/2 exactly (docs/design.md#path-rules: the larger branch). In a wide
+// slab of glass the ray meets the bottom face at the refraction angle; aim it so that the Fresnel
+// reflectance there (closed form from the angles, in double, independent of optics.h) is 0.45, then
+// 0.55. At 0.45 it leaves through the bottom at once, along its entry direction; at 0.55 it
 // reflects and bounces between the faces until the soft cap (16) forces it out.
 TEST(Tracer, FresnelBranchThresholdIsOneHalf) {
     Scene s = sceneOf(flatBox({-100, -100, -0.5f}, {100, 100, 0.5f}), 1.5);

@@ -328,7 +328,7 @@ TEST(Format, PrecisionNamesRoundTrip) {
 TEST(Format, CoefficientCountIsEvenParityCount) {
     BakeData d;
     d.order = 8;
-    EXPECT_EQ(d.coefficientCount(), 45);  // DESIGN.md §2: 45 of 81 at L = 8
+    EXPECT_EQ(d.coefficientCount(), 45);  // docs/conventions.md: 45 of 81 at L = 8
     d.order = 4;
     EXPECT_EQ(d.coefficientCount(), 15);
 }

@@ -1,6 +1,6 @@
-// End to end (DESIGN.md §5): bake a small closed mesh, render it with the SH runtime, the
-// baselines and the Embree reference on both headless backends, and hold the per-pixel direction
-// error to thresholds measured on this machine (Mesa llvmpipe; see each test).
+// End to end (docs/design.md#evaluation): bake a small closed mesh, render it with the SH runtime,
+// the baselines and the Embree reference on both headless backends, and hold the per-pixel
+// direction error to thresholds measured on this machine (Mesa llvmpipe; see each test).
 #include <gtest/gtest.h>
 
 #include <cstdio>

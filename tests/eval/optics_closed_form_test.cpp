@@ -1,5 +1,5 @@
 // Absorption and the front reflection's Fresnel weight through the renderers, against their
-// closed forms (DESIGN.md §4 shading; paper §5.4 "transmittance e^(-kappa d)").
+// closed forms (docs/runtime.md step 6 "Shade"; paper §5.4 "transmittance e^(-kappa d)").
 //
 // A flat glass slab of thickness d = 1 (8 x 8 wide, flat faces with their own normals) in front
 // of a uniform white environment: every direction sees the same radiance 1, so a pixel is

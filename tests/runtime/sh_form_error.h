@@ -1,6 +1,6 @@
 // Float32 error of the GL decompression against a double-precision reference, for comparing
 // the generator's SH evaluation forms (polynomial vs recurrence). Shared by the runtime tests and
-// shrefract-bench-shforms (runtime/cmd/bench-shforms.cpp).
+// shrefract-bench-shforms (eval/cmd/bench-shforms.cpp).
 #pragma once
 
 #include <algorithm>

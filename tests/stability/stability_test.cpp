@@ -1,6 +1,7 @@
-// Where methods fail, on purpose (DESIGN §6): each case goes through the bake, the evaluation
-// against fresh traces and a GL render, and must finish with finite outputs, its trouble
-// reported as shares of affected paths, and errors bounded where the method should cope.
+// Where methods fail, on purpose (docs/design.md#where-methods-fail): each case goes through the
+// bake, the evaluation against fresh traces and a GL render, and must finish with finite outputs,
+// its trouble reported as shares of affected paths, and errors bounded where the method should
+// cope.
 #include <gtest/gtest.h>
 
 #include <cmath>

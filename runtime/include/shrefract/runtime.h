@@ -1,5 +1,5 @@
 // The shrefract runtime: decompresses a bake's SH weights for the current viewpoint on the GPU,
-// builds the seamless refraction map and shades the glass object (paper §5, DESIGN.md §4).
+// builds the seamless refraction map and shades the glass object (paper §5, docs/runtime.md).
 // Every GL entry point uses the caller's current OpenGL 3.3+ core context.
 #pragma once
 
@@ -114,7 +114,7 @@ struct GpuMemory {
     size_t total() const { return weights + samples + rho + neighbours + mesh + targets; }
 };
 
-// The shader limits the generated passes fit (docs/runtime.md "Shader presets"): Modern is one
+// The shader limits the generated passes fit (docs/runtime.md "Shader generator"): Modern is one
 // pass with the weights in a texture array; Paper2006 is the paper's ATI R300 class (16 samplers,
 // 64 ALU instructions per pass, no vertex texture fetch).
 enum class ShaderPreset { Modern, Paper2006 };

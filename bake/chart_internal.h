@@ -23,6 +23,7 @@
 
 #include "bake/chart_layout.h"
 #include "common/bakefile.h"
+#include "common/error.h"
 #include "common/scene.h"
 
 namespace shrefract::charts {
@@ -35,13 +36,6 @@ constexpr double kOutlineMargin = 1.0 / 64.0;
 inline double cross2(glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; }
 inline double signedArea(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
     return 0.5 * cross2(b - a, c - a);
-}
-
-template <class... T>
-std::string str(const T&... parts) {
-    std::ostringstream os;
-    (os << ... << parts);
-    return os.str();
 }
 
 inline uint64_t edgeKey(uint32_t a, uint32_t b) {

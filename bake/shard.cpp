@@ -25,13 +25,6 @@ using nlohmann::json;
 
 namespace {
 
-template <class... T>
-std::string str(const T&... parts) {
-    std::ostringstream os;
-    (os << ... << parts);
-    return os.str();
-}
-
 std::string sliceName(ShardSlice s) { return str("slice ", s.index, " of ", s.count); }
 
 // The identity without what may differ between machines that bake the same thing: the paths

@@ -8,6 +8,18 @@
 
 #include "shrefract/error.h"
 
+namespace shrefract {
+
+// The parts, streamed one after the other into one string: how messages are built.
+template <class... T>
+std::string str(const T&... parts) {
+    std::ostringstream os;
+    (os << ... << parts);
+    return os.str();
+}
+
+}  // namespace shrefract
+
 // A broken invariant is a bug in shrefract, not in the input: print both sides and abort.
 #define SHREFRACT_CHECK(cond)                                                              \
     do {                                                                                   \

@@ -65,13 +65,6 @@ constexpr const char* kErrorModelKey = "errorModel";
 constexpr uint32_t kNoSample = UINT32_MAX;
 constexpr const char* kWeightSuffix[4] = {"x", "y", "z", "len"};
 
-template <class... T>
-std::string str(const T&... parts) {
-    std::ostringstream os;
-    (os << ... << parts);
-    return os.str();
-}
-
 // ---------------------------------------------------------------------------------------------
 // Staging: the channels of one part (or of a band of rows of it), interleaved per texel
 // (exr_planes.cpp).

@@ -114,7 +114,7 @@ int main(int argc, char** argv) {
         const glm::mat4 projection = glm::perspective(glm::radians(45.0f), 1.0f, 0.05f, 50.0f);
         const glm::mat4 viewProjection = projection * view;
         const glm::mat3 rotation(model);
-        refractor->update(eye, model);
+        refractor->update({view, projection, model});
         const GLuint map = refractor->refractionMap();  // built for this update (either path)
 
         shrefract::OffscreenTarget target(size, size);
@@ -137,7 +137,7 @@ int main(int argc, char** argv) {
         // The runtime's own draw of the same frame, for the check.
         const shrefract::Environment env = shrefract::Environment::fromLatLong(2, 1, std::vector<float>(6, 0.5f));
         target.bind();
-        refractor->draw(view, projection, model, env);
+        refractor->draw(env);
         const shrefract::RenderedFrame theirs = target.read();
 
         double worst = 0;

@@ -70,14 +70,15 @@ int main(int argc, char** argv) {
             // update(): per-viewpoint work in texture space (paper Figure 9): local view
             // directions, SH decompression into D_mu, optional smoothing, unpack into the
             // refraction map rho. It restores the app's framebuffer and viewport.
-            refractor->update(eye, model);
+            // The frame's camera and the object's placement, given once.
+            refractor->update({view, projection, model});
 
             // draw(): shades the object into the bound framebuffer with depth testing, looking
             // up the environment through rho (plus Fresnel reflection and absorption). The
             // background is the app's business; here the same environment, drawn first.
             target.bind();
             environment.drawBackground(view, projection, options.toneMap, options.exposure);
-            refractor->draw(view, projection, model, environment);
+            refractor->draw(environment);
 
             // Timings are GPU times of the last update()/draw() (GL timer queries, each stage
             // finished inside its query). Turn RefractorOptions::timings off for throughput.

@@ -7,7 +7,6 @@ import hashlib
 import json
 import math
 import os
-import re
 import subprocess
 import sys
 import time
@@ -141,25 +140,21 @@ class Tools:
         size = size or self.args.size
         spp = self.args.spp if spp is None else spp
         out = os.path.join(self.work, "renders", tag + ".exr")
-        log = out + ".log"
-        if reuse and os.path.exists(out) and os.path.exists(log):
-            text = open(log).read()
-        else:
+        log, summary = out + ".log", out + ".json"
+        if not (reuse and all(os.path.exists(p) for p in (out, log, summary))):
             envPath = env if os.path.sep in env else os.path.join(ROOT, "data", "envmaps", env + ".exr")
             text = self.run([self.exe["render"], bake, "--env", envPath, "--camera",
                              camera if camera.startswith("orbit:") else "orbit:" + camera,
                              "--size", "%dx%d" % (size, size), "--method", method,
                              "--backend", self.args.backend, "--frames", str(self.args.frames),
-                             "--dirs", out] + list(extra) +
+                             "--dirs", out, "--json", summary] + list(extra) +
                             (["--spp", str(spp)] if method == "raytrace" and spp > 1 else []))
             with open(log, "w") as f:
                 f.write(text)
-        ms = re.search(r"ms per frame \(\w+\): ([0-9.]+)", text)
-        mb = re.search(r"GPU memory: ([0-9.]+) MB(?: \+ bracketing bake ([0-9.]+) MB)?", text)
-        memory = None
-        if mb:
-            memory = float(mb.group(1)) + (float(mb.group(2)) if mb.group(2) else 0.0)
-        return {"path": out, "ms": float(ms.group(1)) if ms else None, "memoryMB": memory}
+        with open(summary) as f:
+            measured = json.load(f)  # shrefract-render --json: what the render measured
+        return {"path": out, "ms": measured["msPerFrame"], "timing": measured["timing"],
+                "memoryMB": measured.get("gpuMemoryMB"), "summary": measured}
 
     def compare(self, ref, test, tag):
         """shrefract-eval image: angular error, coverage, PSNR, SSIM of `test` against `ref`."""

@@ -106,10 +106,10 @@ int main(int argc, char** argv) {
                 double ms = -1;
                 if (timed) {
                     auto t = Refractor::create(timingBake, o);
-                    t->update({0.3f, 0.8f, 3.0f});  // warm-up: llvmpipe compiles at first draw
+                    t->update(FrameView::fromEye({0.3f, 0.8f, 3.0f}));  // warm-up: llvmpipe compiles at first draw
                     std::vector<double> v;
                     for (int f = 0; f < frames; ++f) {
-                        t->update({0.3f + 0.01f * f, 0.8f, 3.0f});
+                        t->update(FrameView::fromEye({0.3f + 0.01f * f, 0.8f, 3.0f}));
                         v.push_back(t->timings().decompress);
                     }
                     ms = median(v);

@@ -370,7 +370,7 @@ int main(int argc, char** argv) {
                 summary["shading"] = nameOf(options.shading);
                 if (!dumpDir.empty()) refractor->dumpShaders(dumpDir);
                 if (bake.layout() != "joining") {  // the map's own jump across the seams
-                    refractor->update(cam.eye);
+                    refractor->update(FrameView::fromEye(cam.eye));
                     const std::vector<float> mp = refractor->readRefractionMap();
                     std::vector<glm::vec4> map(mp.size() / 4);
                     for (size_t i = 0; i < map.size(); ++i)

@@ -247,14 +247,14 @@ int main(int argc, char** argv) {
             glm::mat4 view = shrefract::viewMatrix(cam);
             glm::mat4 projection = shrefract::projectionMatrix(cam, fbw, std::max(1, fbh));
             const bool sh = v.method == 0;
-            if (!noObject && sh) refractor->update(cam.eye);
+            if (!noObject && sh) refractor->update({view, projection, glm::mat4(1.0f)});
             glBindFramebuffer(GL_FRAMEBUFFER, 0);
             glViewport(0, 0, fbw, fbh);
             glClearColor(0, 0, 0, 1);
             glDepthMask(GL_TRUE);
             glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
             env.drawBackground(view, projection, true, exposure);
-            if (!noObject && sh) refractor->draw(view, projection, glm::mat4(1.0f), env);
+            if (!noObject && sh) refractor->draw(env);
             if (!noObject && !sh) baselines[v.method - 1]->draw(view, projection, glm::mat4(1.0f), env);
             ensureLoaded(reinterpret_cast<Loader>(&glfwGetProcAddress));
 

@@ -245,8 +245,9 @@ int main(int argc, char** argv) {
                     OffscreenTarget target(vp.x, vp.y);
                     auto body = [&](glm::vec3 eye, const glm::mat4& view,
                                     const glm::mat4& projection) {
-                        refractor->update(eye);
-                        refractor->draw(view, projection, glm::mat4(1.0f), env);
+                        (void)eye;
+                        refractor->update({view, projection, glm::mat4(1.0f)});
+                        refractor->draw(env);
                     };
                     refractor->setTimings(false);
                     FrameTimes t = timeFrames(target, warmup, frames, true, body, [] {});
@@ -317,7 +318,7 @@ int main(int argc, char** argv) {
                 } catch (const std::invalid_argument&) {
                     continue;
                 }
-                r->update(glm::vec3(0.0f, 0.0f, 3.0f));  // render targets are made on first use
+                r->update(FrameView::fromEye(glm::vec3(0.0f, 0.0f, 3.0f)));  // render targets are made on first use
                 others.push_back({{"bake", path},
                                   {"precision", other.data().manifest.value("precision", "")},
                                   {"path", nameOf(r->path())},

@@ -33,6 +33,8 @@ struct Refractor::Impl {
     Timings timings;
     std::unique_ptr<Pipeline> pipeline;
     IorShading ior;  // setIor(): shading at other indices (runtime/src/ior.h)
+    FrameView frame;  // of the last update()
+    bool updated = false;
 
     void use() const { ensureLoaded(loader); }
 };
@@ -116,18 +118,29 @@ Refractor::~Refractor() {
     m.ior.destroy();
 }
 
-void Refractor::update(glm::vec3 eye, const glm::mat4& model) {
+glm::vec3 FrameView::eye() const { return glm::vec3(glm::inverse(view)[3]); }
+
+FrameView FrameView::fromEye(glm::vec3 eye, const glm::mat4& model) {
+    FrameView f;
+    f.view[3] = glm::vec4(-eye, 1.0f);  // a translation: the inverse's origin is `eye` exactly
+    f.model = model;
+    return f;
+}
+
+void Refractor::update(const FrameView& frame) {
     Impl& m = *impl_;
     m.use();
     const SavedTarget saved;
-    const glm::vec3 eyeObject = glm::vec3(glm::inverse(model) * glm::vec4(eye, 1.0f));
+    m.frame = frame;
+    m.updated = true;
+    const glm::vec3 eyeObject = glm::vec3(glm::inverse(frame.model) * glm::vec4(frame.eye(), 1.0f));
     m.timings = Timings{};
     const StageClock clock{m.timer.get(), &m.timings};
     m.pipeline->update(eyeObject, m.ior.active, clock);
     if (m.ior.active && m.ior.bracket) {
         // The bracketing bake's D for the same view; its stages count in this frame's.
         Refractor* other = m.ior.bracket;
-        other->update(eye, model);
+        other->update(frame);
         m.ior.bracketD = m.pipeline->bracketInput(*other->impl_->pipeline);
         const Timings& b = other->impl_->timings;
         m.timings.view += b.view, m.timings.decompress += b.decompress;
@@ -138,22 +151,23 @@ void Refractor::update(glm::vec3 eye, const glm::mat4& model) {
     SHREFRACT_GL_CHECK();
 }
 
-void Refractor::draw(const glm::mat4& view, const glm::mat4& projection, const glm::mat4& model,
-                     const Environment& environment) {
+void Refractor::draw(const Environment& environment) {
     Impl& m = *impl_;
+    if (!m.updated) throw std::logic_error("shrefract: Refractor::draw() before update()");
     m.use();
+    const glm::mat4& model = m.frame.model;
     m.timer->begin(kShade);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     const bool ior = m.ior.active;
     const GLuint p = m.pipeline->shadingProgram(ior ? &m.ior : nullptr);
     glUseProgram(p);
-    FrameUniforms frame(view, projection, model);
-    frame.eta = m.bake.ior();
-    frame.kappa = m.options.absorption.value_or(m.bake.absorption());
-    frame.toneMap = m.options.toneMap;
-    frame.exposure = m.options.exposure;
-    frame.set(p);
+    FrameUniforms uniforms(m.frame.view, m.frame.projection, model);
+    uniforms.eta = m.bake.ior();
+    uniforms.kappa = m.options.absorption.value_or(m.bake.absorption());
+    uniforms.toneMap = m.options.toneMap;
+    uniforms.exposure = m.options.exposure;
+    uniforms.set(p);
     const glm::mat3 rotation(model);
     glUniformMatrix3fv(glGetUniformLocation(p, "uModelRotation"), 1, GL_FALSE, &rotation[0][0]);
     const RefractorOptions& o = m.options;
@@ -166,7 +180,7 @@ void Refractor::draw(const glm::mat4& view, const glm::mat4& projection, const g
     useEnvironment(p, environment, 0);
     if (ior)
         m.ior.setUniforms(p, m.bake.ior(), m.ior.bracket ? m.ior.bracket->impl_->bake.ior() : 0.0f);
-    m.pipeline->draw(p, ior, glm::vec3(glm::inverse(model) * glm::vec4(frame.eye, 1.0f)));
+    m.pipeline->draw(p, ior, glm::vec3(glm::inverse(model) * glm::vec4(uniforms.eye, 1.0f)));
     glBindVertexArray(0);
     glUseProgram(0);
     glActiveTexture(GL_TEXTURE0);

@@ -56,12 +56,11 @@ namespace {
 using DrawObject = std::function<void(const glm::mat4& view, const glm::mat4& projection)>;
 
 // One frame of each kind of method, between binding a target and reading or finishing it.
-DrawObject drawing(Refractor& refractor, const Environment& environment, const Camera& camera) {
-    return [&refractor, &environment, eye = camera.eye](const glm::mat4& view, const glm::mat4& projection) {
-        const glm::mat4 model(1.0f);
-        refractor.update(eye, model);
+DrawObject drawing(Refractor& refractor, const Environment& environment) {
+    return [&refractor, &environment](const glm::mat4& view, const glm::mat4& projection) {
+        refractor.update({view, projection, glm::mat4(1.0f)});
         environment.drawBackground(view, projection);
-        refractor.draw(view, projection, model, environment);
+        refractor.draw(environment);
     };
 }
 DrawObject drawing(Baseline& baseline, const Environment& environment) {
@@ -109,7 +108,7 @@ double timeWith(const DrawObject& drawObject, const Camera& camera, int width, i
 
 RenderedFrame renderFrame(Refractor& refractor, const Environment& environment,
                           const Camera& camera, int width, int height) {
-    RenderedFrame out = renderWith(drawing(refractor, environment, camera), camera, width, height);
+    RenderedFrame out = renderWith(drawing(refractor, environment), camera, width, height);
     out.timings = refractor.timings();
     return out;
 }
@@ -124,7 +123,7 @@ double frameWallMs(Refractor& refractor, const Environment& environment, const C
     // Never with the stage timers: each would wait for the GPU (gpu_timer.h).
     const bool timers = refractor.timingsEnabled();
     refractor.setTimings(false);
-    const double ms = timeWith(drawing(refractor, environment, camera), camera, width, height, frames);
+    const double ms = timeWith(drawing(refractor, environment), camera, width, height, frames);
     refractor.setTimings(timers);
     return ms;
 }

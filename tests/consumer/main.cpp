@@ -72,9 +72,9 @@ int main(int argc, char** argv) {
         glm::vec3 eye(0.0f, 0.0f, 3.0f);
         glm::mat4 view = glm::lookAt(eye, glm::vec3(0.0f), glm::vec3(0, 1, 0));
         glm::mat4 projection = glm::perspective(glm::radians(45.0f), 1.0f, 0.01f, 100.0f);
-        refractor->update(eye);
+        refractor->update({view, projection, glm::mat4(1.0f)});
         target.bind();
-        refractor->draw(view, projection, glm::mat4(1.0f), env);
+        refractor->draw(env);
         RenderedFrame frame = target.read();
         expect(refractor->timings().shade > 0.0 && refractor->passCount() >= 1 &&
                    refractor->memory().total() > 0,

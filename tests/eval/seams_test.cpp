@@ -151,7 +151,7 @@ TEST_F(ChartsEndToEnd, QueryReadsTheChartMapAsTheRuntimeBuildsIt) {
     RefractorOptions o;
     o.loader = context_->loader();
     auto refractor = Refractor::create(makeBake(b.data), o);
-    refractor->update(1e5f * w);
+    refractor->update(FrameView::fromEye(1e5f * w));
     const std::vector<float> m = refractor->readRefractionMap();
     std::vector<glm::vec4> map(m.size() / 4);
     for (size_t i = 0; i < map.size(); ++i) map[i] = {m[4 * i], m[4 * i + 1], m[4 * i + 2], m[4 * i + 3]};

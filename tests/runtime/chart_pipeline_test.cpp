@@ -61,7 +61,7 @@ TEST_P(ChartGl, DecompressionEqualsCpuAtEveryCoveredTexel) {
         const BakeData data = test::randomBake(chartLayout("scenes/vase.obj", kind, 3000, 2), 4);
         auto r = refractor(makeBake(data));
         for (glm::vec3 eye : {glm::vec3(0.3f, 0.8f, 3.0f), glm::vec3(-2.5f, -1.0f, 0.4f)}) {
-            r->update(eye);
+            r->update(FrameView::fromEye(eye));
             const std::vector<float> gl = r->readDirectionalMap();
             float worst = 0;
             for (int i = 0; i < data.layout.sampleCount(); ++i) {
@@ -88,10 +88,10 @@ TEST_P(ChartGl, RefractionMapEqualsTheCpuTwin) {
             for (bool smooth : {false, true}) {
                 auto r = refractor(bake, gutter, seam, smooth);
                 r->setSmoothing(false);
-                r->update(eye);
+                r->update(FrameView::fromEye(eye));
                 const std::vector<glm::vec4> D = asVec4(r->readDirectionalMap());
                 r->setSmoothing(smooth);
-                r->update(eye);
+                r->update(FrameView::fromEye(eye));
                 ChartMapOptions o;
                 o.dilation = gutter, o.seamAware = seam, o.smoothing = smooth;
                 const std::vector<glm::vec4> cpu = chartRefractionMap(data.layout, D.data(), o);
@@ -123,7 +123,7 @@ TEST_P(ChartGl, GuttersAreFilledToTheSetWidth) {
     EXPECT_EQ(r->gutter(), 3);  // the bake's
     for (int width : {0, 1, 3}) {
         r->setGutter(width);
-        r->update(glm::vec3(0, 1, 3));
+        r->update(FrameView::fromEye(glm::vec3(0, 1, 3)));
         const std::vector<glm::vec4> map = asVec4(r->readRefractionMap());
         size_t wrong = 0, ring = 0;
         for (size_t t = 0; t < map.size(); ++t) {
@@ -159,7 +159,7 @@ TEST_P(ChartGl, SeamJumpShrinksFromNoGutterToGutterToSeamAware) {
     const BakeData spaced = smoothField(chartLayout("scenes/vase.obj", LayoutKind::Isolated, 8000, 2));
     auto jump = [&](const BakeData& d, int gutter, bool seam, double q) {
         auto r = refractor(makeBake(d), gutter, seam);
-        r->update(glm::vec3(0, 1, 3));
+        r->update(FrameView::fromEye(glm::vec3(0, 1, 3)));
         return quantile(seamJumps(d.layout, asVec4(r->readRefractionMap())), q);
     };
     const double none = jump(tight, 0, false, 0.5), gutter = jump(spaced, 2, false, 0.5),

@@ -54,8 +54,8 @@ TEST_P(ErrorFoldTest, LengthIsThePredictedLobeAndDirectionIsKept) {
     size_t clamped = 0;
     for (const char* path : {"rho", "direct"}) {
         auto folded = make(bake, path, true), plain = make(bake, path, false);
-        folded->update(eye);
-        plain->update(eye);
+        folded->update(FrameView::fromEye(eye));
+        plain->update(FrameView::fromEye(eye));
         const std::vector<float> f = folded->readDirectionalMap(), p = plain->readDirectionalMap();
         float worstLength = 0, worstDirection = 0;
         for (int i = 0; i < data.layout.sampleCount(); ++i) {
@@ -82,7 +82,7 @@ TEST_P(ErrorFoldTest, BakesWithoutAModelDecompressAsBefore) {
     const BakeData data = test::randomBake(4, 3, 5);  // errorOrder -1
     auto r = make(makeBake(data), "rho", true);
     const glm::vec3 eye(-1.5f, 0.3f, 2.0f);
-    r->update(eye);
+    r->update(FrameView::fromEye(eye));
     const std::vector<float> gl = r->readDirectionalMap();
     float worst = 0;
     for (int i = 0; i < data.layout.sampleCount(); ++i) {

@@ -28,7 +28,7 @@ protected:
 
 // max over samples and channels of |GL - CPU| for D_mu.
 float maxDecompressionError(Refractor& r, const BakeData& d, glm::vec3 eye, int order) {
-    r.update(eye);
+    r.update(FrameView::fromEye(eye));
     std::vector<float> gl = r.readDirectionalMap();
     float worst = 0;
     for (int i = 0; i < d.layout.sampleCount(); ++i) {
@@ -141,10 +141,10 @@ TEST_P(GlTest, RhoIsSeamlessWithCorrectionOnly) {
         BakeData data = test::randomBake(3, rate);
         Bake bake = makeBake(data);
         auto r = refractor(bake);
-        r->update({0.5f, 1.0f, 2.5f});
+        r->update(FrameView::fromEye({0.5f, 1.0f, 2.5f}));
         SeamErrors on = seamErrors(*r, data.layout);
         r->setCorrection(false);
-        r->update({0.5f, 1.0f, 2.5f});
+        r->update(FrameView::fromEye({0.5f, 1.0f, 2.5f}));
         SeamErrors off = seamErrors(*r, data.layout);
         std::printf("[%s] rate %d: seam error with correction %.3g, without %.3g; "
                     "vs interpolateRho %.3g\n",
@@ -160,10 +160,10 @@ TEST_P(GlTest, SmoothingAveragesNeighbours) {
     Bake bake = makeBake(data);
     auto r = refractor(bake);
     glm::vec3 eye(1, 1, 2);
-    r->update(eye);
+    r->update(FrameView::fromEye(eye));
     std::vector<float> raw = r->readDirectionalMap();
     r->setSmoothing(true);
-    r->update(eye);
+    r->update(FrameView::fromEye(eye));
     std::vector<float> smooth = r->readDirectionalMap();
     const SurfaceLayout& L = data.layout;
     float worst = 0;

@@ -146,7 +146,7 @@ TEST_P(Paths, EightBitWeightsStayEightBitOnTheGpu) {
     const glm::vec3 eye(0.3f, 0.8f, 3.0f);
     for (const char* dec : {"vertex", "texture"}) {
         auto r = make(bake, "direct", dec);
-        r->update(eye);
+        r->update(FrameView::fromEye(eye));
         const std::vector<float> gl = r->readDirectionalMap();
         float worst = 0;
         for (int i = 0; i < read.layout.sampleCount(); ++i) {
@@ -183,8 +183,8 @@ TEST_P(Paths, MemoryIsReportedPerPart) {
     EXPECT_EQ(rho->memory().mesh, size_t(L.triangleCount) * 3 * 8 * 4);
     // The direct path builds rho on request, and it is the rho path's map.
     const glm::vec3 eye(0.3f, 0.8f, 3.0f);
-    vertex->update(eye);
-    rho->update(eye);
+    vertex->update(FrameView::fromEye(eye));
+    rho->update(FrameView::fromEye(eye));
     const std::vector<float> a = vertex->readRefractionMap(), b = rho->readRefractionMap();
     EXPECT_EQ(vertex->memory().rho, rho->memory().rho);
     ASSERT_EQ(a.size(), b.size());

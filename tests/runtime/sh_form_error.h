@@ -46,7 +46,7 @@ inline FormError measureFormError(Refractor& r, const BakeData& d,
     std::vector<double> all(shCount(L)), errors;
     errors.reserve(static_cast<size_t>(n) * eyes.size() * 4);
     for (glm::vec3 eye : eyes) {
-        r.update(eye);
+        r.update(FrameView::fromEye(eye));
         std::vector<float> gl = r.readDirectionalMap();
         std::vector<float> view = r.readLocalViewMap();
         for (int i = 0; i < n; ++i) {

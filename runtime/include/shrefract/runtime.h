@@ -229,17 +229,29 @@ struct RefractorOptions {
     void* (*loader)(const char*) = nullptr;  // GL function loader; nullptr: guess from context
 };
 
+// One frame's camera and the object's placement, given once per frame: update() builds the
+// refraction map for this camera and draw() shades with the same one.
+struct FrameView {
+    glm::mat4 view{1.0f};        // world -> camera (e.g. glm::lookAt); the eye is its inverse's origin
+    glm::mat4 projection{1.0f};  // camera -> clip
+    glm::mat4 model{1.0f};       // object -> world
+    glm::vec3 eye() const;       // world space
+    // A camera at `eye` with the world's axes and no projection: for an app that only reads the
+    // refraction map or D back, and draws nothing with it.
+    static FrameView fromEye(glm::vec3 eye, const glm::mat4& model = glm::mat4(1.0f));
+};
+
 class Refractor {
 public:
     // Uploads the bake and compiles the shaders in the current context; throws on GL failure.
     static std::unique_ptr<Refractor> create(const Bake& bake, const RefractorOptions& options = {});
     ~Refractor();
-    // Builds the refraction map for a viewer at `eye` (world space), object placed by `model`.
-    void update(glm::vec3 eye, const glm::mat4& model = glm::mat4(1.0f));
-    // Shades the object into the bound framebuffer: colour to draw buffer 0 (linear HDR unless
-    // toneMap), world exit direction + coverage 1 to draw buffer 1 when one is bound.
-    void draw(const glm::mat4& view, const glm::mat4& projection, const glm::mat4& model,
-              const Environment& environment);
+    // Builds the refraction map for this frame's camera and placement.
+    void update(const FrameView& frame);
+    // Shades the object, as seen by the last update()'s frame, into the bound framebuffer: colour
+    // to draw buffer 0 (linear HDR unless toneMap), world exit direction + coverage 1 to draw
+    // buffer 1 when one is bound. Before any update(): std::logic_error.
+    void draw(const Environment& environment);
     // The refraction map for an app's own material: GL_TEXTURE_2D, RGBA32F, GL_LINEAR: the rho
     // layout (docs/integrate.md), or for chart bakes the atlas, in the mesh's own UV space for uv
     // bakes (looked up at the app's texture coordinates). On the direct path it is built on first

@@ -28,24 +28,6 @@ double secondsSince(Clock::time_point t0) {
 
 }  // namespace
 
-const char* ToString(Fit fit) {
-    switch (fit) {
-        case Fit::Projection:
-            return "projection";
-        case Fit::LeastSquares:
-            return "lsq";
-        case Fit::Weighted:
-            return "weighted";
-    }
-    return "unknown";
-}
-
-Fit parseFit(const std::string& text) {
-    for (Fit f : {Fit::Projection, Fit::LeastSquares, Fit::Weighted})
-        if (text == ToString(f)) return f;
-    throw InputError("unknown fit \"" + text + "\" (expected projection, lsq or weighted)");
-}
-
 std::vector<int> evenBands(int L) {
     std::vector<int> bands;
     for (const ShLM& f : shEvenFunctions(L)) bands.push_back(f.l);
@@ -265,10 +247,10 @@ SliceResult BakePlan::bakeSlice(size_t beginBatch, size_t endBatch, const SliceP
 }
 
 nlohmann::json BakePlan::manifest(const BakeStats& stats) const {
-    nlohmann::json layoutInfo = {{"kind", ToString(layout_.kind)}};
+    nlohmann::json layoutInfo = {{"kind", nameOf(layout_.kind)}};
     if (layout_.isChartLayout()) {
         const ChartStats& c = charts_;
-        layoutInfo["method"] = layout_.kind == LayoutKind::Isolated ? ToString(opt_.charts.method) : "mesh uv";
+        layoutInfo["method"] = layout_.kind == LayoutKind::Isolated ? nameOf(opt_.charts.method) : "mesh uv";
         layoutInfo["seamMesh"] = c.seamMesh;
         layoutInfo["coneDegrees"] = opt_.charts.coneDegrees;
         layoutInfo["maxDensityRatio"] = opt_.charts.maxDensityRatio;
@@ -303,7 +285,7 @@ nlohmann::json BakePlan::manifest(const BakeStats& stats) const {
         {"input", absolute(input_)},
         {"grid", {opt_.grid.nTheta, opt_.grid.nPhi}},
         {"filterWidth", opt_.filterWidth},
-        {"fit", ToString(opt_.fit)},
+        {"fit", nameOf(opt_.fit)},
         {"fitWeighting", opt_.fit == Fit::Weighted ? opt_.weighting.ToString() : ""},
         {"branch", opt_.trace.branch == Branch::Fresnel ? "fresnel" : "transmit"},
         {"maxBounces", opt_.trace.maxBounces},

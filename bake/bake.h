@@ -13,6 +13,7 @@
 #include <mutex>
 #include <string>
 
+#include "shrefract/enum_names.h"
 #include "bake/chart_layout.h"
 #include "bake/fit.h"
 #include "bake/residual.h"
@@ -41,8 +42,11 @@ enum class Fit {
     LeastSquares,  // solid-angle-weighted least squares on the grid samples
     Weighted,      // least squares weighted by each path's confidence (bake/fit.h)
 };
-const char* ToString(Fit fit);   // "projection" | "lsq" | "weighted"
-Fit parseFit(const std::string& text);  // throws InputError
+template <> struct EnumNames<Fit> {
+    static constexpr const char* what = "fit";
+    static constexpr NamedValue<Fit> table[] = {
+        {Fit::Projection, "projection"}, {Fit::LeastSquares, "lsq"}, {Fit::Weighted, "weighted"}};
+};
 
 struct BakeOptions {
     int order = 8;           // SH order L

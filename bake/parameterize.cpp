@@ -15,7 +15,6 @@
 
 namespace shrefract {
 
-const char* ToString(ChartMethod m) { return m == ChartMethod::Lscm ? "lscm" : "arap"; }
 
 namespace {
 

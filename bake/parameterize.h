@@ -9,10 +9,16 @@
 
 #include <glm/glm.hpp>
 
+#include "shrefract/enum_names.h"
+
 namespace shrefract {
 
 enum class ChartMethod { Lscm, Arap };
-const char* ToString(ChartMethod m);
+template <> struct EnumNames<ChartMethod> {
+    static constexpr const char* what = "chart method";
+    static constexpr NamedValue<ChartMethod> table[] = {{ChartMethod::Lscm, "lscm"},
+                                                        {ChartMethod::Arap, "arap"}};
+};
 
 // One closed or open triangle mesh with vertices welded by position, and the chart of every
 // triangle. Every chart must be a topological disk (bake/chart_unfold.cpp checks that first).

@@ -69,14 +69,14 @@ BakeOptions optionsOf(const json& id) {
     BakeOptions o;
     o.order = id.value("order", -1);
     if (o.order < 0 || o.order > 100) throw InputError(str("SH order ", o.order, " is absurd"));
-    o.precision = parsePrecision(id.value("precision", ""));
+    o.precision = parseInput<Precision>(id.value("precision", ""));
     o.rate = id.value("rate", 0);
     if (o.rate < 1) throw InputError(str("rate ", o.rate, " is below 1"));
     const json grid = id.value("grid", json::array());
     if (!grid.is_array() || grid.size() != 2) throw InputError("no direction grid");
     o.grid = parseGrid(str(grid[0].get<int>(), "x", grid[1].get<int>()), "grid");
     o.filterWidth = id.value("filterWidth", 0.0);
-    o.fit = parseFit(id.value("fit", "projection"));
+    o.fit = parseInput<Fit>(id.value("fit", "projection"));
     if (o.fit == Fit::Weighted) o.weighting = FitWeighting::parse(id.value("fitWeighting", ""), "fitWeighting");
     o.trace.branch = id.value("branch", "") == "transmit" ? Branch::Transmit : Branch::Fresnel;
     o.trace.maxBounces = id.value("maxBounces", 32);
@@ -165,7 +165,7 @@ json shardIdentity(const BakePlan& plan) {
     id.erase("stats");
     const BakeOptions& o = plan.options();
     id["order"] = o.order;
-    id["precision"] = ToString(o.precision);
+    id["precision"] = nameOf(o.precision);
     id["rate"] = plan.layout().rate;
     id["sampleCount"] = plan.sampleCount();
     id["batch"] = kBakeBatch;

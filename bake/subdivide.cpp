@@ -21,12 +21,6 @@ namespace shrefract {
 
 using OMesh = OpenMesh::TriMesh_ArrayKernelT<>;
 
-Subdivision parseSubdivision(const std::string& text) {
-    if (text == "loop") return Subdivision::Loop;
-    if (text == "sqrt3") return Subdivision::Sqrt3;
-    throw InputError("unknown subdivision \"" + text + "\" (expected loop or sqrt3)");
-}
-
 SubdivisionResult subdivideMeshFile(const std::string& input, const std::string& output,
                                     Subdivision scheme, int steps) {
     if (steps < 0 || steps > 6) throw inputError(output, "subdivision steps must be 0..6");

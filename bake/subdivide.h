@@ -5,13 +5,19 @@
 #include <cstddef>
 #include <string>
 
+#include "shrefract/enum_names.h"
+
 namespace shrefract {
 
 enum class Subdivision {
     Loop,   // Loop 1987: 4 triangles per triangle, a vertex per edge
     Sqrt3,  // Kobbelt 2000: 3 triangles per triangle, a vertex per face
 };
-Subdivision parseSubdivision(const std::string& text);  // "loop" | "sqrt3"; throws InputError
+template <> struct EnumNames<Subdivision> {
+    static constexpr const char* what = "subdivision";
+    static constexpr NamedValue<Subdivision> table[] = {{Subdivision::Loop, "loop"},
+                                                        {Subdivision::Sqrt3, "sqrt3"}};
+};
 
 struct SubdivisionResult {
     size_t vertices = 0, triangles = 0;

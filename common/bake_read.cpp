@@ -92,11 +92,7 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options, ui
         if (layout == m.end() || !layout->is_object() || !layout->contains("kind") ||
             !(*layout)["kind"].is_string())
             throw InputError("manifest has no \"layout\" kind");
-        try {
-            L.kind = parseLayoutKind((*layout)["kind"].get<std::string>());
-        } catch (const InputError&) {
-            throw InputError(str("unknown layout kind ", (*layout)["kind"].dump()));
-        }
+        L.kind = parseInput<LayoutKind>((*layout)["kind"].get<std::string>());
         layoutInfo = *layout;
     }
 
@@ -111,7 +107,7 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options, ui
                              " coefficients, order ", d.order, " has ", K));
     if (!m.contains("precision") || !m["precision"].is_string())
         throw InputError("manifest has no \"precision\"");
-    d.precision = parsePrecision(m["precision"].get<std::string>());
+    d.precision = parseInput<Precision>(m["precision"].get<std::string>());
 
     const int N = manifestInt(m, "sampleCount");
     const std::vector<int> mu = manifestInts(m, "mu", 2), rho = manifestInts(m, "rho", 2),

@@ -120,7 +120,7 @@ void writeBake(const std::string& path, const BakeData& data) {
     m["version"] = kFormatVersion;
     m["order"] = data.order;
     m["coefficients"] = data.coefficientCount();
-    m["precision"] = ToString(data.precision);
+    m["precision"] = nameOf(data.precision);
     m["sampleCount"] = L.sampleCount();
     m["mu"] = {L.muWidth, L.muHeight};
     m["rho"] = {L.rhoWidth, L.rhoHeight};
@@ -132,7 +132,7 @@ void writeBake(const std::string& path, const BakeData& data) {
     // "layout": the kind and, for charts, the part sizes are the writer's; other keys the bake
     // tool put there stay (descriptive).
     json layout = m.contains("layout") && m["layout"].is_object() ? m["layout"] : json::object();
-    layout["kind"] = ToString(L.kind);
+    layout["kind"] = nameOf(L.kind);
     for (const char* key : {"gutter", "charts", "vertices", "triangles", "seamSources"}) layout.erase(key);
     if (L.isChartLayout()) {
         const ChartAtlas& A = L.atlas;

@@ -9,6 +9,8 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include "shrefract/enum_names.h"
+
 namespace shrefract {
 
 // 2: per-part and manifest checksums, the layout kind and the chart layouts; 3: the error model
@@ -26,12 +28,20 @@ constexpr float kErrorOffset = 0.01f;
 //             atlas with gutters; mu = rho = the atlas, the samples are the covered texel centres.
 //   Uv        the same, with the mesh's own texture coordinates as the charts.
 enum class LayoutKind { Joining, Isolated, Uv };
-const char* ToString(LayoutKind k);                // "joining" | "isolated" | "uv"
-LayoutKind parseLayoutKind(const std::string& text);  // throws InputError
+template <> struct EnumNames<LayoutKind> {
+    static constexpr const char* what = "layout kind";
+    static constexpr NamedValue<LayoutKind> table[] = {
+        {LayoutKind::Joining, "joining"}, {LayoutKind::Isolated, "isolated"}, {LayoutKind::Uv, "uv"}};
+};
 
+// How the weights are stored (docs/format.md): float32, float16, or 8-bit codes with a scale and
+// offset per coefficient.
 enum class Precision { F32, F16, U8 };
-const char* ToString(Precision p);
-Precision parsePrecision(const std::string& text);  // "f32" | "f16" | "u8"; throws InputError
+template <> struct EnumNames<Precision> {
+    static constexpr const char* what = "weight precision";
+    static constexpr NamedValue<Precision> table[] = {
+        {Precision::F32, "f32"}, {Precision::F16, "f16"}, {Precision::U8, "u8"}};
+};
 
 // One texel of the rho layout. kind Sample: shows mu sample a. kind Correction: the texel just
 // outside a triangle's hypotenuse, value = D[a] + D[b] - D[c] (v11 = v01 + v10 - v00), so that

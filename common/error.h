@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "shrefract/enum_names.h"
 #include "shrefract/error.h"
 
 namespace shrefract {
@@ -16,6 +17,17 @@ std::string str(const T&... parts) {
     std::ostringstream os;
     (os << ... << parts);
     return os.str();
+}
+
+// parseName<E> (shrefract/enum_names.h) for a word read from a file: a wrong word is the file's
+// problem, so InputError instead of std::invalid_argument.
+template <class E>
+E parseInput(std::string_view text) {
+    try {
+        return parseName<E>(text);
+    } catch (const std::invalid_argument& e) {
+        throw InputError(e.what());
+    }
 }
 
 }  // namespace shrefract

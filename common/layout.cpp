@@ -6,25 +6,6 @@
 
 namespace shrefract {
 
-const char* ToString(LayoutKind k) {
-    switch (k) {
-        case LayoutKind::Joining:
-            return "joining";
-        case LayoutKind::Isolated:
-            return "isolated";
-        case LayoutKind::Uv:
-            return "uv";
-    }
-    return "unknown";
-}
-
-LayoutKind parseLayoutKind(const std::string& text) {
-    if (text == "joining") return LayoutKind::Joining;
-    if (text == "isolated") return LayoutKind::Isolated;
-    if (text == "uv") return LayoutKind::Uv;
-    throw InputError("unknown layout kind \"" + text + "\" (expected joining, isolated or uv)");
-}
-
 glm::ivec2 SurfaceLayout::muTexel(int i) const {
     if (!isChartLayout()) return {i % muWidth, i / muWidth};
     const uint32_t t = atlas.sampleTexel[static_cast<size_t>(i)];

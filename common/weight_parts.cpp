@@ -13,25 +13,6 @@
 
 namespace shrefract {
 
-const char* ToString(Precision p) {
-    switch (p) {
-        case Precision::F32:
-            return "f32";
-        case Precision::F16:
-            return "f16";
-        case Precision::U8:
-            return "u8";
-    }
-    return "unknown";
-}
-
-Precision parsePrecision(const std::string& text) {
-    if (text == "f32") return Precision::F32;
-    if (text == "f16") return Precision::F16;
-    if (text == "u8") return Precision::U8;
-    throw InputError("unknown weight precision \"" + text + "\" (expected f32, f16 or u8)");
-}
-
 int BakeData::coefficientCount() const { return shEvenCount(order); }
 int BakeData::errorCoefficientCount() const { return errorOrder < 0 ? 0 : shEvenCount(errorOrder); }
 

@@ -406,4 +406,18 @@ void writePng8(const std::string& path, const Image8& image) {
     writePngRgb8(path, image.width, image.height, image.rgb.data());
 }
 
+double meanAbsToneMappedDifference(const std::vector<float>& a, const std::vector<float>& b,
+                                   float exposure) {
+    if (a.size() != b.size() || a.size() % 4 != 0)
+        throw std::invalid_argument("meanAbsToneMappedDifference: the frames differ in size");
+    double sum = 0;
+    const size_t n = a.size() / 4;
+    for (size_t i = 0; i < n; ++i) {
+        const glm::vec3 x = toneMapAces(glm::vec3(a[4 * i], a[4 * i + 1], a[4 * i + 2]), exposure);
+        const glm::vec3 y = toneMapAces(glm::vec3(b[4 * i], b[4 * i + 1], b[4 * i + 2]), exposure);
+        sum += std::abs(x.r - y.r) + std::abs(x.g - y.g) + std::abs(x.b - y.b);
+    }
+    return sum / (3.0 * std::max<size_t>(1, n));
+}
+
 }  // namespace shrefract

@@ -48,6 +48,11 @@ nlohmann::json compareImages(const EvalBuffer& ref, const EvalBuffer& test, floa
 // Mean SSIM of two single-channel images in [0, 1] (the definition above); exposed for tests.
 double ssim(const std::vector<float>& a, const std::vector<float>& b, int width, int height);
 
+// The flicker measure: the mean absolute difference of two RGBA frames' tone-mapped colours (all
+// pixels, RGB in [0, 1]), e.g. consecutive frames of a slow orbit (shrefract-render --flicker).
+double meanAbsToneMappedDifference(const std::vector<float>& a, const std::vector<float>& b,
+                                   float exposure = 1.0f);
+
 // The error colour ramp: 0 degrees dark blue through green and yellow to red at maxDegrees
 // (and beyond).
 glm::u8vec3 errorColor(float degrees, float maxDegrees);

@@ -176,6 +176,26 @@ EvalBuffer composeChannels(const EvalBuffer& red, const EvalBuffer& green, const
     return out;
 }
 
+EvalBuffer renderDispersed(const Scene& scene, const TraceOptions& options,
+                           const ReferenceEnvironment& environment, const ReferenceView& view,
+                           glm::vec3 ior, ReferenceStats* stats) {
+    if (scene.parts.empty()) throw std::invalid_argument("renderDispersed: the scene has no part");
+    EvalBuffer channel[3];
+    for (int c = 0; c < 3; ++c) {
+        if (c > 0 && ior[c] == ior[c - 1]) {
+            channel[c] = channel[c - 1];
+            continue;
+        }
+        Scene atIndex = scene;
+        atIndex.parts[0].medium.ior = ior[c];
+        const Tracer tracer(atIndex, options);
+        ReferenceStats st;
+        channel[c] = renderReference(tracer, environment, view, &st);
+        if (stats && (c == 1 || stats->covered == 0)) *stats = st;
+    }
+    return composeChannels(channel[0], channel[1], channel[2]);
+}
+
 std::vector<float> normalDistances(const Tracer& tracer, const std::vector<glm::vec3>& p,
                                    const std::vector<glm::vec3>& n) {
     std::vector<float> d(p.size(), 0.0f);

@@ -76,6 +76,13 @@ EvalBuffer renderReference(const Tracer& tracer, const ReferenceEnvironment& env
 // with the scene at that channel's index), and how three grey renders become one dispersive one.
 EvalBuffer composeChannels(const EvalBuffer& red, const EvalBuffer& green, const EvalBuffer& blue);
 
+// The dispersion reference: the scene's first part (the object of a bare mesh) at `ior[c]` for
+// colour channel c, one render per distinct index, composed by composeChannels. `stats`: the
+// green channel's render.
+EvalBuffer renderDispersed(const Scene& scene, const TraceOptions& options,
+                           const ReferenceEnvironment& environment, const ReferenceView& view,
+                           glm::vec3 ior, ReferenceStats* stats = nullptr);
+
 // d_N of Wyman 2005 per point: the distance from p along the inward normal -n to the next
 // surface of the scene (0 if none), measured between true surface points. Parallel.
 std::vector<float> normalDistances(const Tracer& tracer, const std::vector<glm::vec3>& p,

@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
             double c = cpuSeconds();
             res = bake(scene, opt, input);
             const double cpuDefault = cpuSeconds() - c;
-            fits[ToString(opt.fit)] = {{"seconds", res.stats.wallSeconds}, {"cpuSeconds", cpuDefault},
+            fits[nameOf(opt.fit)] = {{"seconds", res.stats.wallSeconds}, {"cpuSeconds", cpuDefault},
                                        {"compressThreadSeconds", res.stats.compressSeconds}};
             if (!noFitRatio && opt.fit != Fit::Projection) {
                 BakeOptions p = opt;
@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
                 fits["ratio"] = {{"wall", res.stats.wallSeconds / ps.wallSeconds},
                                  {"cpu", cpuDefault / cpuProjection},
                                  {"target", 1.3},
-                                 {"note", std::string(ToString(opt.fit)) + " over projection, same run"}};
+                                 {"note", std::string(nameOf(opt.fit)) + " over projection, same run"}};
             }
             if (!noFitRatio && opt.errorOrder >= 0) {
                 // The error model's cost (docs/bake.md "Error model"): the same bake without it.

@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
     app.add_option("--max-bounces", opt.trace.maxBounces, "bounce cap per path")->capture_default_str()->check(CLI::Range(1, limits::kMaxBounces));
     app.add_option("--filter", opt.filterWidth, "semi-Gaussian SH low-pass width in bands (0: none)")
         ->capture_default_str()->check(CLI::Range(0.0, limits::kMaxFilterWidth));
-    std::string fit = ToString(opt.fit), weighting = opt.weighting.ToString();
+    std::string fit = nameOf(opt.fit), weighting = opt.weighting.ToString();
     app.add_option("--fit", fit, "projection: W = M R through the compression matrix (the paper); lsq: "
                                  "least squares on the grid samples; weighted: least squares weighted by "
                                  "each path's confidence (docs/bake.md \"Fits\")")
@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
             opt.cancel = cli::cancelOnSignals();
             opt.rate = rate;
             opt.samples = samples;
-            opt.layout = parseLayoutKind(layout);
+            opt.layout = parseName<LayoutKind>(layout);
             if (opt.layout != LayoutKind::Joining && rate > 0)
                 throw InputError("--rate is for --layout joining; chart layouts take --samples or --texels");
             if (opt.layout == LayoutKind::Joining && !texels.empty())
@@ -135,8 +135,8 @@ int main(int argc, char** argv) {
             }
             opt.grid = parseGrid(grid, "--grid");
             opt.trace.branch = branch == "transmit" ? Branch::Transmit : Branch::Fresnel;
-            opt.precision = parsePrecision(precision);
-            opt.fit = parseFit(fit);
+            opt.precision = parseName<Precision>(precision);
+            opt.fit = parseName<Fit>(fit);
             opt.weighting = FitWeighting::parse(weighting);
             opt.cacheDir = cache;
             opt.coherent = tracer == "coherent";
@@ -282,7 +282,7 @@ int main(int argc, char** argv) {
                 const ChartStats& c = s.charts;
                 std::printf("  samples     %zu covered texels of a %dx%d atlas (%.2f texels/sample), %s "
                             "layout, %d triangles\n",
-                            s.samples, L.muWidth, L.muHeight, s.rhoOverhead, ToString(L.kind), L.triangleCount);
+                            s.samples, L.muWidth, L.muHeight, s.rhoOverhead, nameOf(L.kind), L.triangleCount);
                 std::printf("  charts      %d (%d splits, %d unfolded by ARAP), gutter %d, density spread "
                             "%.2fx, largest conformal distortion %.2f\n",
                             c.charts, c.splits, c.arapCharts, L.atlas.gutter, c.densitySpread,

@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
         ->capture_default_str()->check(CLI::IsMember({"loop", "sqrt3"}));
     app.add_option("--steps", steps, "subdivision steps")->capture_default_str()->check(CLI::Range(0, 6));
     return cli::run(app, "shrefract-subdivide", argc, argv, [&] {
-        const SubdivisionResult r = subdivideMeshFile(input, output, parseSubdivision(scheme), steps);
+        const SubdivisionResult r = subdivideMeshFile(input, output, parseName<Subdivision>(scheme), steps);
         std::printf("%s -> %s: %zu vertices, %zu triangles\n", input.c_str(), output.c_str(), r.vertices,
                     r.triangles);
         return int(cli::kOk);

@@ -18,6 +18,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "runtime/src/bake_data.h"
 #include "common/cli/cli.h"
 #include "common/output.h"
 #include "shadergen.h"

@@ -13,13 +13,14 @@
 
 #include <CLI/CLI.hpp>
 
+#include "runtime/src/bake_data.h"
 #include "common/cli/cli.h"
 #include "common/decompress.h"
 #include "common/error.h"
 #include "common/evalbuffer.h"
 #include "common/output.h"
-#include "common/tonemap.h"
 #include "eval/directions.h"
+#include "eval/image_eval.h"
 #include "eval/reference.h"
 #include "shrefract/baselines.h"
 #include "shrefract/context.h"
@@ -60,18 +61,6 @@ struct Method {
     std::function<double(const Camera&)> wallMs;
     std::string timing;  // what "ms per frame" is
 };
-
-// Mean absolute difference of the tone-mapped colours of two frames (all pixels, RGB in [0, 1]).
-double meanAbsDifference(const RenderedFrame& a, const RenderedFrame& b, float exposure) {
-    double sum = 0;
-    const size_t n = a.color.size() / 4;
-    for (size_t i = 0; i < n; ++i) {
-        const glm::vec3 x = toneMapAces(glm::vec3(a.color[4 * i], a.color[4 * i + 1], a.color[4 * i + 2]), exposure);
-        const glm::vec3 y = toneMapAces(glm::vec3(b.color[4 * i], b.color[4 * i + 1], b.color[4 * i + 2]), exposure);
-        sum += std::abs(x.r - y.r) + std::abs(x.g - y.g) + std::abs(x.b - y.b);
-    }
-    return sum / (3.0 * std::max<size_t>(1, n));
-}
 
 }  // namespace
 
@@ -255,18 +244,18 @@ int main(int argc, char** argv) {
         std::unique_ptr<BakeData> seamBake;  // whose seams to measure the render's jump across
         if (!seamsOf.empty())
             seamBake = std::make_unique<BakeData>(readBake(seamsOf));
-        else if (bake.data().layout.isChartLayout())
-            seamBake = std::make_unique<BakeData>(bake.data());
+        else if (bakeData(bake).layout.isChartLayout())
+            seamBake = std::make_unique<BakeData>(bakeData(bake));
         if (!seamsOf.empty() && !seamBake->layout.isChartLayout())
             throw std::invalid_argument("--seams-of " + seamsOf + ": a joining bake has no seams");
 
         std::unique_ptr<Scene> scene;
         std::unique_ptr<Tracer> tracer;
         if (method == "raytrace" || method == "wyman" || seamBake) {
-            scene = std::make_unique<Scene>(sceneOfBake(bake.data(), bakePath, scenePath));
+            scene = std::make_unique<Scene>(sceneOfBake(bakeData(bake), bakePath, scenePath));
             if (!kappa.empty())
                 for (Part& p : scene->parts) p.medium.absorption = {kappa[0], kappa[1], kappa[2]};
-            tracer = std::make_unique<Tracer>(*scene, traceOptionsOfBake(bake.data()));
+            tracer = std::make_unique<Tracer>(*scene, traceOptionsOfBake(bakeData(bake)));
         }
 
         // Set the method up once; `render` draws one camera's frame.
@@ -288,21 +277,7 @@ int main(int argc, char** argv) {
                 ReferenceStats stats;
                 EvalBuffer b;
                 if (ior.x > 0) {
-                    // The first part (the object of a bare mesh) at each channel's index.
-                    EvalBuffer channel[3];
-                    for (int ch = 0; ch < 3; ++ch) {
-                        if (ch > 0 && ior[ch] == ior[ch - 1]) {
-                            channel[ch] = channel[ch - 1];
-                            continue;
-                        }
-                        Scene sc = *scene;
-                        sc.parts[0].medium.ior = ior[ch];
-                        Tracer t(sc, traceOptionsOfBake(bake.data()));
-                        ReferenceStats st;
-                        channel[ch] = renderReference(t, *envImage, view, &st);
-                        if (ch == 1 || stats.covered == 0) stats = st;
-                    }
-                    b = composeChannels(channel[0], channel[1], channel[2]);
+                    b = renderDispersed(*scene, traceOptionsOfBake(bakeData(bake)), *envImage, view, ior, &stats);
                 } else {
                     b = renderReference(*tracer, *envImage, view, &stats);
                 }
@@ -375,7 +350,7 @@ int main(int argc, char** argv) {
                     std::vector<glm::vec4> map(mp.size() / 4);
                     for (size_t i = 0; i < map.size(); ++i)
                         map[i] = {mp[4 * i], mp[4 * i + 1], mp[4 * i + 2], mp[4 * i + 3]};
-                    nlohmann::json st = jumpStats({}, seamJumps(bake.data().layout, map));
+                    nlohmann::json st = jumpStats({}, seamJumps(bakeData(bake).layout, map));
                     summary["mapSeams"] = st;
                     if (st["count"].get<size_t>() > 0)
                         std::printf("refraction map across %zu smooth seam points: jump median %.3f, "
@@ -397,7 +372,7 @@ int main(int argc, char** argv) {
                 options.tir = tir;
                 options.loader = context->loader();
                 std::vector<float> normalDistance;
-                if (tracer) normalDistance = normalDistances(*tracer, bake.data().layout);
+                if (tracer) normalDistance = normalDistances(*tracer, bakeData(bake).layout);
                 baseline = Baseline::create(bake, normalDistance, options);
                 m.render = [&](const Camera& c, double*) {
                     return renderFrame(*baseline, *env, c, width, height);
@@ -420,7 +395,7 @@ int main(int argc, char** argv) {
                 Camera c = Camera::orbit(orbit[0] + f * flickerStep, orbit[1], orbit[2]);
                 c.fovDegrees = fov;
                 frame = m.render(c, &ms);
-                if (f > 0) diffs.push_back(meanAbsDifference(previous, frame, exposure));
+                if (f > 0) diffs.push_back(meanAbsToneMappedDifference(previous.color, frame.color, exposure));
                 previous = frame;
             }
             double mean = 0;

@@ -20,6 +20,7 @@
 #include <CLI/CLI.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "runtime/src/bake_data.h"
 #include "gl.h"  // the runtime's loader: the viewer needs a handful of GL calls of its own
 #include "common/bakefile.h"
 #include "common/cli/cli.h"
@@ -188,9 +189,9 @@ int main(int argc, char** argv) {
         // The other methods share the mesh; Wyman's d_N is cast once here.
         std::vector<float> normalDistance;
         {
-            shrefract::Scene scene = shrefract::sceneOfBake(bake.data(), bakePath);
-            shrefract::Tracer tracer(scene, shrefract::traceOptionsOfBake(bake.data()));
-            normalDistance = shrefract::normalDistances(tracer, bake.data().layout);
+            shrefract::Scene scene = shrefract::sceneOfBake(bakeData(bake), bakePath);
+            shrefract::Tracer tracer(scene, shrefract::traceOptionsOfBake(bakeData(bake)));
+            normalDistance = shrefract::normalDistances(tracer, bakeData(bake).layout);
         }
         std::vector<std::unique_ptr<shrefract::Baseline>> baselines;
         for (shrefract::BaselineMethod m : {shrefract::BaselineMethod::Single, shrefract::BaselineMethod::Wyman}) {
@@ -206,7 +207,7 @@ int main(int argc, char** argv) {
         Viewer v;
         {
             glm::vec3 lo(1e30f), hi(-1e30f);
-            for (glm::vec3 p : bake.data().layout.position) lo = glm::min(lo, p), hi = glm::max(hi, p);
+            for (glm::vec3 p : bakeData(bake).layout.position) lo = glm::min(lo, p), hi = glm::max(hi, p);
             v.centre = 0.5f * (lo + hi);
             v.radius = std::max(0.5f * glm::length(hi - lo), 1e-30f);
             v.distance = 3.0f * v.radius;

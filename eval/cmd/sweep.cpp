@@ -17,6 +17,7 @@
 #include <set>
 #include <sstream>
 
+#include "runtime/src/bake_data.h"
 #include "bake/bake.h"
 #include "eval/image_eval.h"
 #include "bake/joining_layout.h"
@@ -293,7 +294,7 @@ int main(int argc, char** argv) {
                     writeBake(tmp, q);
                     Bake read = loadBake(tmp);
                     std::remove(tmp.c_str());
-                    point("precision", ToString(p), p == Precision::F32 ? 32 : p == Precision::F16 ? 16 : 8,
+                    point("precision", nameOf(p), p == Precision::F32 ? 32 : p == Precision::F16 ? 16 : 8,
                           renderSh(read, RefractorOptions{}));
                 }
                 // Projection against a least-squares fit (order 8, same grid and rate).

@@ -24,6 +24,7 @@
 #include <glm/gtc/type_ptr.hpp>
 #include <nlohmann/json.hpp>
 
+#include "bake_data.h"
 #include "common/bakefile.h"
 #include "common/cli/cli.h"
 #include "common/output.h"
@@ -320,7 +321,7 @@ int main(int argc, char** argv) {
                 }
                 r->update(FrameView::fromEye(glm::vec3(0.0f, 0.0f, 3.0f)));  // render targets are made on first use
                 others.push_back({{"bake", path},
-                                  {"precision", other.data().manifest.value("precision", "")},
+                                  {"precision", bakeData(other).manifest.value("precision", "")},
                                   {"path", nameOf(r->path())},
                                   {"decompression", nameOf(r->decompression())},
                                   {"memory", memoryJson(r->memory())}});

@@ -1,6 +1,5 @@
-#include "common/bakefile.h"
+#include "bake_data.h"
 #include "common/error.h"
-#include "shrefract/runtime.h"
 
 namespace shrefract {
 
@@ -10,30 +9,26 @@ Bake loadBake(const std::string& path, bool verify) {
     return makeBake(readBake(path, options));
 }
 
-Bake makeBake(BakeData data) {
-    Bake b;
-    b.data_ = std::make_shared<const BakeData>(std::move(data));
-    return b;
-}
+Bake makeBake(BakeData data) { return Bake(std::make_shared<const Bake::Impl>(Bake::Impl{std::move(data)})); }
 
-const BakeData& Bake::data() const {
-    SHREFRACT_CHECK(data_ != nullptr);
-    return *data_;
-}
-int Bake::order() const { return data().order; }
-const std::vector<std::string>& Bake::warnings() const { return data().warnings; }
+Bake::Bake(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) { SHREFRACT_CHECK(impl_ != nullptr); }
+
+const Bake::Impl& Bake::impl() const { return *impl_; }
+
+int Bake::order() const { return bakeData(*this).order; }
+const std::vector<std::string>& Bake::warnings() const { return bakeData(*this).warnings; }
 
 std::vector<MapVertex> Bake::refractionMapMesh() const {
     // The layout's drawn mesh (common/bakefile.h drawCorners): joining, each triangle's corner
     // samples (0,0), (r,0), (0,r) at their rho texel centres (docs/format.md "rho"); charts, the
     // unfolded mesh at its atlas UVs.
     std::vector<MapVertex> out;
-    for (const DrawCorner& c : drawCorners(data().layout)) out.push_back({c.position, c.normal, c.uv});
+    for (const DrawCorner& c : drawCorners(bakeData(*this).layout)) out.push_back({c.position, c.normal, c.uv});
     return out;
 }
-int Bake::sampleCount() const { return data().layout.sampleCount(); }
-int Bake::triangleCount() const { return data().layout.triangleCount; }
-std::string Bake::layout() const { return ToString(data().layout.kind); }
+int Bake::sampleCount() const { return bakeData(*this).layout.sampleCount(); }
+int Bake::triangleCount() const { return bakeData(*this).layout.triangleCount; }
+std::string Bake::layout() const { return nameOf(bakeData(*this).layout.kind); }
 
 // The first medium of the manifest is the object's (docs/format.md "media").
 static const nlohmann::json* firstMedium(const BakeData& d) {
@@ -44,13 +39,13 @@ static const nlohmann::json* firstMedium(const BakeData& d) {
 }
 
 float Bake::ior() const {
-    const nlohmann::json* m = firstMedium(data());
+    const nlohmann::json* m = firstMedium(bakeData(*this));
     if (m && m->contains("ior") && (*m)["ior"].is_number()) return (*m)["ior"].get<float>();
     return 1.5f;
 }
 
 glm::vec3 Bake::absorption() const {
-    const nlohmann::json* m = firstMedium(data());
+    const nlohmann::json* m = firstMedium(bakeData(*this));
     if (m && m->contains("absorption") && (*m)["absorption"].is_array() &&
         (*m)["absorption"].size() == 3)
         return {(*m)["absorption"][0].get<float>(), (*m)["absorption"][1].get<float>(),

@@ -1,6 +1,7 @@
 // Single-sided refraction and Wyman 2005 (docs/evaluation.md). Pass 1 (Wyman only) draws the
 // nearest back faces' normals and view depth into a viewport-sized RGBA32F target; pass 2 shades
 // the front faces into the caller's framebuffer.
+#include "bake_data.h"
 #include "shrefract/baselines.h"
 
 #include <cmath>
@@ -67,7 +68,7 @@ std::unique_ptr<Baseline> Baseline::create(const Bake& bake, const std::vector<f
     m->loader = options.loader ? options.loader : currentContextLoader();
     m->use();
     if (!glGetString(GL_VERSION)) throw std::runtime_error("shrefract: no current OpenGL context");
-    const SurfaceLayout& L = bake.data().layout;
+    const SurfaceLayout& L = bakeData(bake).layout;
     const size_t points = L.isChartLayout() ? L.atlas.vertexPosition.size() : size_t(L.sampleCount());
     if (options.method == BaselineMethod::Wyman && normalDistance.size() != points)
         throw std::invalid_argument("shrefract: Wyman needs d_N for every drawn point (" +

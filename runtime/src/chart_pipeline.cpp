@@ -1,3 +1,4 @@
+#include "bake_data.h"
 #include "chart_pipeline.h"
 
 #include <algorithm>
@@ -33,14 +34,14 @@ const std::string& ChartPipeline::vertexShader() const {
 }
 
 ChartPipeline::ChartPipeline(const PipelineInputs& in)
-    : layout_(in.bake.data().layout), settings_(in.settings), width_(layout_.muWidth),
+    : layout_(bakeData(in.bake).layout), settings_(in.settings), width_(layout_.muWidth),
       height_(layout_.muHeight),
       dilation_(std::max(0, in.options.gutter < 0 ? layout_.atlas.gutter : in.options.gutter)),
       seamAware_(in.options.seamAware), mesh_(in.bake, in.memory) {
     const SurfaceLayout& layout = layout_;
     if (in.options.path != RefractorPath::Auto && in.options.path != RefractorPath::Charts)
         throw std::invalid_argument(std::string("shrefract: path \"") + nameOf(in.options.path) +
-                                    "\" for a " + ToString(layout.kind) +
+                                    "\" for a " + nameOf(layout.kind) +
                                     " bake (chart bakes take \"charts\")");
     // The atlas is the refraction map; the unfolded mesh draws it in texture space and shades.
     atlas_.create(width_, height_, GL_LINEAR);
@@ -96,7 +97,7 @@ ChartPipeline::ChartPipeline(const PipelineInputs& in)
     glUseProgram(0);
     in.memory.rho = indexBytes();
     in.memory.targets += targetBytes();
-    decompression_ = std::make_unique<Decompression>(in.bake.data(), in.options, in.maxOrder,
+    decompression_ = std::make_unique<Decompression>(bakeData(in.bake), in.options, in.maxOrder,
                                                      in.limits, in.form, *this, in.memory);
     prepare();
 }

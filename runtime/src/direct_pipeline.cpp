@@ -1,3 +1,4 @@
+#include "bake_data.h"
 #include "direct_pipeline.h"
 
 #include <stdexcept>
@@ -12,11 +13,11 @@ namespace shrefract {
 using namespace gl;
 
 DirectPipeline::DirectPipeline(const PipelineInputs& in)
-    : layout_(in.bake.data().layout),
+    : layout_(bakeData(in.bake).layout),
       settings_(in.settings),
       memory_(in.memory),
       grid_(layout_, in.memory),
-      decompression_(in.bake.data(), in.options, in.maxOrder, in.limits, in.form, grid_, in.memory) {
+      decompression_(bakeData(in.bake), in.options, in.maxOrder, in.limits, in.form, grid_, in.memory) {
     const DecompressionSite site = in.options.decompression;
     if (site == DecompressionSite::Vertex && in.options.smoothing)
         throw std::invalid_argument(

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "bake_data.h"
 #include "chart_pipeline.h"
 #include "common/bakefile.h"
 #include "decompression.h"
@@ -46,7 +47,7 @@ namespace {
 // app asks for rho), else rho.
 std::unique_ptr<Pipeline> makePipeline(const PipelineInputs& in) {
     const RefractorOptions& o = in.options;
-    if (in.bake.data().layout.isChartLayout()) return std::make_unique<ChartPipeline>(in);
+    if (bakeData(in.bake).layout.isChartLayout()) return std::make_unique<ChartPipeline>(in);
     if (o.path == RefractorPath::Charts)
         throw std::invalid_argument("shrefract: path \"charts\" for a joining bake (direct | rho | auto)");
     const bool direct = o.path == RefractorPath::Direct ||
@@ -77,7 +78,7 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
     if (major * 10 + minor < 33)
         throw std::runtime_error(std::string("shrefract: needs OpenGL 3.3 core, context is ") +
                                  reinterpret_cast<const char*>(version));
-    const BakeData& d = bake.data();
+    const BakeData& d = bakeData(bake);
     const SurfaceLayout& L = d.layout;
     if (L.sampleCount() == 0 || L.muWidth * L.muHeight < L.sampleCount() || L.triangleCount == 0)
         throw std::invalid_argument("shrefract: bake has an empty or inconsistent layout");
@@ -206,7 +207,7 @@ void Refractor::resetIor() { impl_->ior.active = false; }
 
 void Refractor::setIorBracket(Refractor* other) {
     if (other) {
-        const SurfaceLayout &a = impl_->bake.data().layout, &b = other->impl_->bake.data().layout;
+        const SurfaceLayout &a = bakeData(impl_->bake).layout, &b = bakeData(other->impl_->bake).layout;
         if (other == this || a.sampleCount() != b.sampleCount() ||
             a.triangleCount != b.triangleCount || a.rate != b.rate ||
             a.muWidth != b.muWidth || a.rhoWidth != b.rhoWidth || a.rhoHeight != b.rhoHeight)

@@ -1,3 +1,4 @@
+#include "bake_data.h"
 #include "rho_pipeline.h"
 
 #include "ior.h"
@@ -8,9 +9,9 @@ using namespace gl;
 
 RhoPipeline::RhoPipeline(const PipelineInputs& in)
     : settings_(in.settings),
-      grid_(in.bake.data().layout, in.memory),
-      decompression_(in.bake.data(), in.options, in.maxOrder, in.limits, in.form, grid_, in.memory),
-      map_(in.bake.data().layout, in.memory),
+      grid_(bakeData(in.bake).layout, in.memory),
+      decompression_(bakeData(in.bake), in.options, in.maxOrder, in.limits, in.form, grid_, in.memory),
+      map_(bakeData(in.bake).layout, in.memory),
       mesh_(in.bake, in.memory) {
     prepare();
 }

@@ -343,7 +343,7 @@ INSTANTIATE_TEST_SUITE_P(Objects, ChartLayout, ::testing::ValuesIn(kCases),
 TEST(ChartLayoutSize, SamplesReachTheTargetAndTexelsSetTheAtlas) {
     const Scene vase = loadScene(data("scenes/vase.obj"), Medium{});
     for (LayoutKind kind : {LayoutKind::Isolated, LayoutKind::Uv}) {
-        SCOPED_TRACE(ToString(kind));
+        SCOPED_TRACE(nameOf(kind));
         ChartOptions opt;
         opt.kind = kind;
         opt.samples = 6000;

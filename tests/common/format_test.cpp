@@ -320,9 +320,9 @@ void expectInputError(const fs::path& path, const std::string& what) {
 
 TEST(Format, PrecisionNamesRoundTrip) {
     for (Precision p : {Precision::F32, Precision::F16, Precision::U8})
-        EXPECT_EQ(parsePrecision(ToString(p)), p) << ToString(p);
-    EXPECT_THROW(parsePrecision("f64"), InputError);
-    EXPECT_THROW(parsePrecision("F32"), InputError);
+        EXPECT_EQ(parseInput<Precision>(nameOf(p)), p) << nameOf(p);
+    EXPECT_THROW(parseInput<Precision>("f64"), InputError);
+    EXPECT_THROW(parseInput<Precision>("F32"), InputError);
 }
 
 TEST(Format, CoefficientCountIsEvenParityCount) {
@@ -352,7 +352,7 @@ TEST(Format, RoundTripF32IsExact) {
 // precision, bit for bit; its manifest says what it holds.
 TEST(Format, ErrorModelRoundTripsExactly) {
     for (Precision p : {Precision::F32, Precision::U8}) {
-        const fs::path path = scratch() / (std::string(ToString(p)) + ".shrefract.exr");
+        const fs::path path = scratch() / (std::string(nameOf(p)) + ".shrefract.exr");
         BakeData d = syntheticBake(p);
         d.errorOrder = 2;
         std::mt19937 rng(3);
@@ -365,7 +365,7 @@ TEST(Format, ErrorModelRoundTripsExactly) {
         EXPECT_EQ(r.manifest["errorModel"]["order"], 2);
         EXPECT_EQ(r.manifest["errorModel"]["unit"], "radians");
         ASSERT_EQ(r.errorOrder, 2);
-        ASSERT_EQ(r.errors, d.errors) << ToString(p);
+        ASSERT_EQ(r.errors, d.errors) << nameOf(p);
     }
 }
 
@@ -500,10 +500,10 @@ TEST(Format, ManifestKeepsCallerFieldsAndAddsLayout) {
 TEST(Format, LayoutArraysSurviveRoundTrip) {
     const fs::path dir = scratch();
     for (Precision p : {Precision::F32, Precision::F16, Precision::U8}) {
-        const fs::path path = dir / (std::string(ToString(p)) + ".shrefract.exr");
+        const fs::path path = dir / (std::string(nameOf(p)) + ".shrefract.exr");
         const BakeData d = syntheticBake(p, 11);
         writeBake(path.string(), d);
-        SCOPED_TRACE(ToString(p));
+        SCOPED_TRACE(nameOf(p));
         expectLayoutEqual(readBake(path.string()).layout, d.layout);
     }
 }
@@ -513,8 +513,8 @@ TEST(Format, LayoutArraysSurviveRoundTrip) {
 TEST(Format, ChartLayoutRoundTrips) {
     const fs::path dir = scratch();
     for (Precision p : {Precision::F32, Precision::F16, Precision::U8}) {
-        SCOPED_TRACE(ToString(p));
-        const fs::path path = dir / (std::string(ToString(p)) + ".shrefract.exr");
+        SCOPED_TRACE(nameOf(p));
+        const fs::path path = dir / (std::string(nameOf(p)) + ".shrefract.exr");
         const BakeData d = syntheticChartBake(p);
         writeBake(path.string(), d);
         const BakeData r = readBake(path.string());
@@ -576,7 +576,7 @@ TEST(Format, InconsistentChartLayoutsAreReported) {
     const fs::path ok = dir / "ok.shrefract.exr";
     writeBake(ok.string(), syntheticChartBake(Precision::F32));
     rewrite(ok, dir / "kind.shrefract.exr", [](json& m) { m["layout"]["kind"] = "spiral"; });
-    expectInputError(dir / "kind.shrefract.exr", "unknown layout kind \"spiral\"");
+    expectInputError(dir / "kind.shrefract.exr", "unknown layout kind 'spiral'");
     // rho shows sample 3 twice (texel 0 copies texel 14's index).
     rewrite(ok, dir / "twice.shrefract.exr", [](json&) {},
             [](const std::string& p, const std::string& c, std::vector<char>& bytes) {
@@ -914,8 +914,8 @@ TEST(Format, WeightBytesPerTexelPerCoefficient) {
     int j = 0;
     for (Precision p : {Precision::F32, Precision::F16, Precision::U8}) {
         d.precision = order0.precision = p;
-        const fs::path path = dir / (std::string(ToString(p)) + ".exr");
-        const fs::path path0 = dir / (std::string(ToString(p)) + "-order0.exr");
+        const fs::path path = dir / (std::string(nameOf(p)) + ".exr");
+        const fs::path path0 = dir / (std::string(nameOf(p)) + "-order0.exr");
         writeBake(path.string(), d);
         writeBake(path0.string(), order0);
         const double size = double(fs::file_size(path)), size0 = double(fs::file_size(path0));
@@ -923,7 +923,7 @@ TEST(Format, WeightBytesPerTexelPerCoefficient) {
         std::printf(
             "[ sizes    ] %s: %.0f bytes (order 0: %.0f), %.3f bytes per texel per "
             "coefficient\n",
-            ToString(p), size, size0, perTexel[j - 1]);
+            nameOf(p), size, size0, perTexel[j - 1]);
     }
     EXPECT_GT(perTexel[0], perTexel[1]);
     EXPECT_GT(perTexel[1], perTexel[2]);
@@ -1065,7 +1065,7 @@ TEST(Format, RandomCorruptionIsRefusedOrHarmless) {
                 ++refused;
             }
         }
-        std::printf("[ damage   ] %s: %d refused, %d harmless (%d truncations)\n", ToString(precision),
+        std::printf("[ damage   ] %s: %d refused, %d harmless (%d truncations)\n", nameOf(precision),
                     refused, harmless, truncations);
         EXPECT_EQ(refused + harmless, 500);
         EXPECT_GT(refused, 400);  // most bytes of a small file are data, offsets or the manifest

@@ -7,6 +7,7 @@
 #include <limits>
 #include <memory>
 
+#include "runtime/src/bake_data.h"
 #include "bake/bake.h"
 #include "eval/directions.h"
 #include "eval/image_eval.h"

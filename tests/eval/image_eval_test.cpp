@@ -85,6 +85,20 @@ TEST(ImageEval, IdenticalImagesHaveZeroErrorAndSsimOne) {
     EXPECT_EQ(r["psnr"].get<double>(), 99.0);
 }
 
+// The flicker measure: 0 for equal frames; one pixel of n changed from black to c reads
+// (tm(c).r + tm(c).g + tm(c).b) / 3n, tm the display transform (toneMapAces(0) = 0).
+TEST(ImageEval, FlickerMeasureIsTheMeanToneMappedDifference) {
+    const size_t n = 40;
+    std::vector<float> a(n * 4, 0.0f), b = a;
+    EXPECT_EQ(meanAbsToneMappedDifference(a, b), 0.0);
+    const glm::vec3 c(0.7f, 2.0f, 0.05f);
+    b[4 * 7 + 0] = c.r, b[4 * 7 + 1] = c.g, b[4 * 7 + 2] = c.b;
+    const glm::vec3 t = toneMapAces(c, 2.0f);
+    EXPECT_NEAR(meanAbsToneMappedDifference(a, b, 2.0f), (t.r + t.g + t.b) / (3.0 * n), 1e-7);
+    EXPECT_EQ(meanAbsToneMappedDifference(a, b), meanAbsToneMappedDifference(b, a));
+    EXPECT_THROW(meanAbsToneMappedDifference(a, std::vector<float>(8)), std::invalid_argument);
+}
+
 TEST(ImageEval, KnownAngleAndCoverageMismatch) {
     EvalBuffer a = randomBuffer(16, 16, 1), b = a;
     for (size_t i = 0; i < a.pixelCount(); ++i)

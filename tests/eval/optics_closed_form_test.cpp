@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "runtime/src/bake_data.h"
 #include "bake/bake.h"
 #include "bake/test_meshes.h"
 #include "eval/reference.h"

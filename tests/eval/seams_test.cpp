@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 
+#include "runtime/src/bake_data.h"
 #include "bake/bake.h"
 #include "common/decompress.h"
 #include "common/latlong.h"
@@ -103,8 +104,8 @@ TEST_F(ChartsEndToEnd, ChartLayoutsMatchTheReferenceAsWellAsJoining) {
             EXPECT_GE(b.data.layout.sampleCount(), 4898);
             const double m = median(compareImages(ref, evalOf(renderSh(b, c))));
             std::printf("  view %g,%g: median joining %.3f, %s %.3f deg (%d samples)\n", view.x,
-                        view.y, joining, ToString(kind), m, b.data.layout.sampleCount());
-            EXPECT_LT(m, 1.1 * joining) << ToString(kind);
+                        view.y, joining, nameOf(kind), m, b.data.layout.sampleCount());
+            EXPECT_LT(m, 1.1 * joining) << nameOf(kind);
         }
     }
 }

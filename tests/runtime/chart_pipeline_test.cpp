@@ -8,6 +8,7 @@
 #include <cmath>
 #include <map>
 
+#include "bake_data.h"
 #include "bake/chart_layout.h"
 #include "common/decompress.h"
 #include "common/error.h"
@@ -24,7 +25,7 @@ namespace {
 // Chart layouts of the data objects, built once (CGAL takes a fraction of a second each).
 const SurfaceLayout& chartLayout(const std::string& file, LayoutKind kind, size_t samples, int gutter) {
     static std::map<std::string, SurfaceLayout> cache;
-    const std::string key = file + ToString(kind) + std::to_string(samples) + "g" + std::to_string(gutter);
+    const std::string key = file + nameOf(kind) + std::to_string(samples) + "g" + std::to_string(gutter);
     auto it = cache.find(key);
     if (it != cache.end()) return it->second;
     ChartOptions opt;
@@ -69,10 +70,10 @@ TEST_P(ChartGl, DecompressionEqualsCpuAtEveryCoveredTexel) {
                 for (int c = 0; c < 4; ++c) worst = std::max(worst, std::abs(gl[4 * i + c] - cpu[c]));
             }
             std::printf("[%s] %s: max |GL - CPU| = %.3g over %d texels\n", nameOf(GetParam()),
-                        ToString(kind), worst, data.layout.sampleCount());
+                        nameOf(kind), worst, data.layout.sampleCount());
             // Measured 1e-5..4e-5: the view vector interpolated from the vertices in float, where
             // the CPU takes the sample's stored point; a wrong texel would be off by O(1).
-            EXPECT_LT(worst, 5e-4f) << ToString(kind);
+            EXPECT_LT(worst, 5e-4f) << nameOf(kind);
         }
     }
 }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "bake_data.h"
 #include "common/decompress.h"
 #include "common/latlong.h"
 #include "common/prefilter.h"

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "bake_data.h"
 #include "common/bakefile.h"
 #include "common/error.h"
 #include "test_bake.h"

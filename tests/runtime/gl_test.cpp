@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 
+#include "bake_data.h"
 #include "common/decompress.h"
 #include "common/error.h"
 #include "shrefract/context.h"

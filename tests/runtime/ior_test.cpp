@@ -9,6 +9,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "bake_data.h"
 #include "shrefract/context.h"
 #include "shrefract/render.h"
 #include "shrefract/runtime.h"

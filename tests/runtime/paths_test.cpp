@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "bake_data.h"
 #include "common/decompress.h"
 #include "common/latlong.h"
 #include "common/prefilter.h"

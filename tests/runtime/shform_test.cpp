@@ -7,6 +7,7 @@
 #include <cfloat>
 #include <map>
 
+#include "bake_data.h"
 #include "common/error.h"
 #include "shadergen.h"
 #include "sh_form_error.h"

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "runtime/src/bake_data.h"
 #include "bake/bake.h"
 #include "eval/directions.h"
 #include "common/error.h"
@@ -97,7 +98,7 @@ CaseResult runCase(const std::string& name, const std::string& what, const Scene
              {"raysPerPath", double(s.rays) / std::max<size_t>(1, s.paths)},
              {"tir", share(s.tir)}, {"capped", share(s.capped)}, {"softCapped", share(s.softCapped)},
              {"reentered", share(s.reentered)}, {"geometricNormal", share(s.geometricNormal)},
-             {"leaked", share(s.leaked)}, {"precision", ToString(opt.precision)}, {"order", opt.order},
+             {"leaked", share(s.leaked)}, {"precision", nameOf(opt.precision)}, {"order", opt.order},
              {"directions", r.eval}, {"render", render}};
     fs::create_directories(kTmp + "/rows");
     std::ofstream(kTmp + "/rows/" + name + ".json") << r.row.dump(2) << "\n";

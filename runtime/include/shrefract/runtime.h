@@ -15,8 +15,6 @@
 
 namespace shrefract {
 
-struct BakeData;  // common/bakefile.h
-
 // A vertex of the mesh the refraction map is laid out for (Bake::refractionMapMesh).
 struct MapVertex {
     glm::vec3 position;  // object space
@@ -42,19 +40,22 @@ public:
     // an app that shades the glass in its own material draws these and samples the map at uv
     // (docs/integrate.md).
     std::vector<MapVertex> refractionMapMesh() const;
-    const BakeData& data() const;
+
+    // What loading made, opaque to apps (the project's own tools and tests read it through
+    // runtime/src/bake_data.h).
+    struct Impl;
+    Bake() = default;  // empty: loadBake() makes the ones to use
+    explicit Bake(std::shared_ptr<const Impl> impl);
+    const Impl& impl() const;
 
 private:
-    friend Bake makeBake(BakeData data);
-    std::shared_ptr<const BakeData> data_;
+    std::shared_ptr<const Impl> impl_;
 };
 
 // Reads NAME.shrefract.exr and checks every part against its checksum (`verify` false skips
 // that: faster, but a corrupt file may then draw garbage); throws InputError naming the file
 // and the problem (missing, corrupt, newer format).
 Bake loadBake(const std::string& path, bool verify = true);
-// Wraps bake data already in memory (tests, tools that bake and render in one process).
-Bake makeBake(BakeData data);
 
 // An HDR environment as a GL cube map (RGB32F, seamless), with a mip chain prefiltered for spread
 // shading: level l >= 1 is level 0 convolved with a vMF lobe one texel of that level wide

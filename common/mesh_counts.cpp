@@ -163,7 +163,19 @@ void checkOff(const std::string& path, const std::string& text) {
 struct PlyProperty {
     int size = 0;           // scalar, or the list's item
     int countSize = 0;      // list only: the size of its length
+    bool integer = false;   // the scalar or the list's items are integers
 };
+
+bool isPlyFloatType(const std::string& type) { return type.find("float") != std::string::npos || type == "double"; }
+
+// An ASCII PLY value as its property's type reads it: an optional sign and digits for integers.
+bool isPlyValue(const std::string& t, bool integer) {
+    // Decimal syntax only: strtod's "inf", "nan" and hex floats stop a C++ stream too.
+    if (!integer) return isNumber(t) && t.find_first_not_of("0123456789+-.eE") == std::string::npos;
+    const size_t digits = t[0] == '-' || t[0] == '+' ? 1 : 0;
+    return t.size() > digits && t.size() <= 12 &&
+           std::all_of(t.begin() + digits, t.end(), [](unsigned char c) { return std::isdigit(c); });
+}
 
 struct PlyElement {
     std::string name;
@@ -234,9 +246,11 @@ void checkPly(const std::string& path, const std::string& whole) {
             if (t.size() == 5 && t[1] == "list") {
                 p.countSize = plyTypeSize(t[2]);
                 p.size = plyTypeSize(t[3]);
-                if (t[2].find("float") != std::string::npos || t[2] == "double") p.countSize = 0;
+                p.integer = !isPlyFloatType(t[3]);
+                if (isPlyFloatType(t[2])) p.countSize = 0;
             } else if (t.size() == 3) {
                 p.size = plyTypeSize(t[1]);
+                p.integer = !isPlyFloatType(t[1]);
             }
             if (p.size == 0 || (t[1] == "list" && p.countSize == 0))
                 throw bad("is not a property of a known type");
@@ -265,6 +279,13 @@ void checkPly(const std::string& path, const std::string& whole) {
                     if (p.countSize > 0 && (at >= t.size() || !isCount(t[at++], &n)))
                         throw inputError(path, e.name + " " + std::to_string(r) +
                                                    ": a list without its length");
+                    // Every value a number of its type: OpenMesh's reader stops at the first
+                    // that is not and loops on (found by the fuzzer: "3HHH" as a face index
+                    // grew a vector to 2 GB).
+                    for (size_t v = at; v < at + size_t(n) && v < t.size(); ++v)
+                        if (!isPlyValue(t[v], p.integer))
+                            throw inputError(path, e.name + " " + std::to_string(r) + ": '" + t[v] +
+                                                       "' is not " + (p.integer ? "an integer" : "a number"));
                     at += size_t(n);
                 }
                 if (at > t.size())

@@ -75,7 +75,9 @@ void writeShard(const std::string& path, const ShardData& shard) {
     if (shard.errorOrder > limits::kMaxErrorOrder || shard.errors.size() != size_t(Ke) * shard.sampleCount)
         throw std::invalid_argument(str("writeShard(", path, "): ", shard.errors.size(),
                                         " error model values, expected ", Ke, " x ", shard.sampleCount));
-    const auto [width, height] = neighbourListSize(shard.sampleCount);
+    // Plain variables, not a structured binding: the lambdas below capture them (C++17).
+    const auto listSize = neighbourListSize(shard.sampleCount);
+    const int width = listSize.first, height = listSize.second;
     const WeightsPart part{shard.weights.data(), shard.sampleCount, K, Precision::F32, width, height};
     std::unique_ptr<Planes> errors;
     if (Ke > 0) errors = std::make_unique<Planes>(errorPlanes(shard.errors.data(), shard.sampleCount, Ke, width, height, nullptr));

@@ -307,6 +307,13 @@ TEST(Mesh, CutShortFilesAreRefused) {
                      "binary STL cut short or padded: its header promises 12 triangles (684 bytes)");
     expectInputError(writeText("short.ply", ply.substr(0, ply.size() - 13)),
                      "cut short: the header promises 12 face elements, the file ends after 11");
+    // Values that are not numbers of their type (found by the fuzzer: OpenMesh's ASCII PLY reader
+    // looped on "3HHH" as a face index until it held 2 GB; "inf" stops a C++ stream as well).
+    std::string badIndex = asciiPly, badCoordinate = asciiPly;
+    badIndex.replace(badIndex.rfind("\n3 ") + 3, 1, "3HHH");
+    badCoordinate.replace(badCoordinate.find("end_header\n") + 11, 1, "inf");
+    expectInputError(writeText("index.ply", badIndex), "'3HHH' is not an integer");
+    expectInputError(writeText("coordinate.ply", badCoordinate), "is not a number");
     expectInputError(writeText("short.obj", "v 0 0 0\nv 1 0 0\nv 0 1\n"),
                      "line 3: a vertex is not 3 numbers");
     expectInputError(writeText("corner.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 f 3\n"),

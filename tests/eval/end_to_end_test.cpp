@@ -14,7 +14,7 @@
 #include "eval/reference.h"
 #include "common/latlong.h"
 #include "common/scene.h"
-#include "headless_test.h"
+#include "support/headless.h"
 #include "shrefract/baselines.h"
 #include "shrefract/context.h"
 #include "shrefract/render.h"

@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "support/headless.h"
 #include "runtime/src/bake_data.h"
 #include "bake/bake.h"
 #include "bake/test_meshes.h"
@@ -117,13 +118,9 @@ TEST(OpticsClosedForm, ReferenceSlabAbsorptionAndFresnel) {
 // d / cos(theta_t)). Measured within 6.3e-5 at every angle and channel; threshold 1e-3, below
 // the smallest step a planted bug makes here (exp(-kappa * d) without the 1 / cos(theta_t) at
 // 30 degrees: 0.013 in blue).
-TEST(OpticsClosedForm, ShRuntimeSlabAbsorptionAndFresnel) {
-    std::unique_ptr<HeadlessContext> context;
-    try {
-        context = createHeadlessContext(Backend::Egl, kSize, kSize);
-    } catch (const ContextError& e) {
-        GTEST_SKIP() << "no EGL context: " << e.what();
-    }
+using OpticsClosedFormGl = test::EglTest<kSize>;
+
+TEST_F(OpticsClosedFormGl, ShRuntimeSlabAbsorptionAndFresnel) {
     const LatLongImage img = white();
     Environment env = Environment::fromLatLong(img.width, img.height, img.rgb);
     for (glm::vec3 kappa : {kKappa, glm::vec3(1e4f)}) {
@@ -139,7 +136,7 @@ TEST(OpticsClosedForm, ShRuntimeSlabAbsorptionAndFresnel) {
         o.trace.branch = Branch::Transmit;
         BakeResult baked = bake(s, o, "slab");
         RefractorOptions ro;
-        ro.loader = context->loader();
+        ro.loader = context_->loader();
         auto refractor = Refractor::create(makeBake(baked.data), ro);
         for (double theta : kAngles) {
             RenderedFrame f = renderFrame(*refractor, env, cameraAt(theta), kSize, kSize);

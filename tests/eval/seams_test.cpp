@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 
+#include "support/headless.h"
 #include "runtime/src/bake_data.h"
 #include "bake/bake.h"
 #include "common/decompress.h"
@@ -60,14 +61,11 @@ ReferenceView viewOf(const Camera& c) {
     return v;
 }
 
-class ChartsEndToEnd : public ::testing::Test {
+class ChartsEndToEnd : public test::EglTest<kSize> {
 protected:
     void SetUp() override {
-        try {
-            context_ = createHeadlessContext(Backend::Egl, kSize, kSize);
-        } catch (const ContextError& e) {
-            GTEST_SKIP() << "no EGL context: " << e.what();
-        }
+        test::EglTest<kSize>::SetUp();
+        if (IsSkipped()) return;
         const std::string envPath = std::string(SHREFRACT_DATA_DIR) + "/envmaps/courtyard.exr";
         latLong_ = std::make_unique<ReferenceEnvironment>(loadLatLong(envPath));
         env_ = std::make_unique<Environment>(Environment::fromLatLong(
@@ -82,7 +80,6 @@ protected:
         return renderFrame(*refractor, *env_, c, kSize, kSize);
     }
     EvalBuffer evalOf(const RenderedFrame& f) { return makeEvalBuffer(kSize, kSize, f.color, f.directions); }
-    std::unique_ptr<HeadlessContext> context_;
     std::unique_ptr<ReferenceEnvironment> latLong_;
     std::unique_ptr<Environment> env_;
 };

@@ -12,7 +12,7 @@
 #include "common/latlong.h"
 #include "common/prefilter.h"
 #include "common/sh.h"
-#include "headless_test.h"
+#include "support/headless.h"
 #include "shrefract/render.h"
 #include "shrefract/runtime.h"
 #include "test_bake.h"

@@ -11,7 +11,7 @@
 #include "shrefract/context.h"
 #include "shrefract/render.h"
 #include "shrefract/runtime.h"
-#include "headless_test.h"
+#include "support/headless.h"
 #include "test_bake.h"
 
 namespace shrefract {

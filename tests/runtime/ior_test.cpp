@@ -9,6 +9,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "support/headless.h"
 #include "bake_data.h"
 #include "shrefract/context.h"
 #include "shrefract/render.h"
@@ -33,15 +34,8 @@ Environment gradientEnvironment() {
 }
 
 // Both interpolation paths: rho (the paper's refraction map) and direct (D per vertex).
-class IorTest : public ::testing::TestWithParam<const char*> {
+class IorTest : public test::EglTest<kSize, ::testing::TestWithParam<const char*>> {
 protected:
-    void SetUp() override {
-        try {
-            context_ = createHeadlessContext(Backend::Egl, kSize, kSize);
-        } catch (const ContextError& e) {
-            GTEST_SKIP() << "no EGL context: " << e.what();
-        }
-    }
     std::unique_ptr<Refractor> refractor(const BakeData& d) {
         RefractorOptions o;
         o.loader = context_->loader();
@@ -55,7 +49,6 @@ protected:
         return renderFrame(r, *env_, camera_, kSize, kSize);
     }
     Camera camera_ = Camera::orbit(35, 25, 3.0f);
-    std::unique_ptr<HeadlessContext> context_;
     std::unique_ptr<Environment> env_;
     void TearDown() override { env_.reset(); }
 };

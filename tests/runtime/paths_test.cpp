@@ -13,7 +13,7 @@
 #include "common/latlong.h"
 #include "common/prefilter.h"
 #include "common/sh.h"
-#include "headless_test.h"
+#include "support/headless.h"
 #include "shrefract/context.h"
 #include "shrefract/render.h"
 #include "shrefract/runtime.h"

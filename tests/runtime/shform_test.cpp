@@ -7,6 +7,7 @@
 #include <cfloat>
 #include <map>
 
+#include "support/headless.h"
 #include "bake_data.h"
 #include "common/error.h"
 #include "shadergen.h"
@@ -26,15 +27,8 @@ double cancellationBound(int L) {
     return 2.0 * FLT_EPSILON * (m + shEvenCount(L));
 }
 
-class ShFormTest : public ::testing::Test {
+class ShFormTest : public test::EglTest<> {
 protected:
-    void SetUp() override {
-        try {
-            context_ = createHeadlessContext(Backend::Egl, 64, 64);
-        } catch (const ContextError& e) {
-            GTEST_SKIP() << "no EGL context: " << e.what();
-        }
-    }
     test::FormError error(const BakeData& data, const std::string& form, std::string* used = nullptr,
                           const std::string& preset = "modern") {
         RefractorOptions o;
@@ -45,7 +39,6 @@ protected:
         if (used) *used = nameOf(r->form());
         return test::measureFormError(*r, data, test::formErrorEyes());
     }
-    std::unique_ptr<HeadlessContext> context_;
 };
 
 // Measured on llvmpipe (octahedron, rate 8, 4 eyes, weights uniform in [-1, 1]), max error:

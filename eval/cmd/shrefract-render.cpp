@@ -1,32 +1,22 @@
 // shrefract-render: renders a bake in front of an environment, headless (EGL or OSMesa), with the
-// SH runtime, a baseline or the ray-traced reference (README "shrefract-render").
-// A thin shell over the runtime library (shrefract/render.h, shrefract/baselines.h) and, for
-// raytrace and Wyman's d_N, the evaluation layer (eval/reference.h, Embree through bake/): the
-// runtime library itself never links the bake. Every output is checked before the render and
-// written only when all succeed (common/output.h); exit codes as every tool's (README).
-#include <algorithm>
+// SH runtime, a baseline or the ray-traced reference (README "shrefract-render"). A thin shell:
+// it parses the command line into a RenderRequest, and eval/render_method.h sets the method up
+// and draws; the flicker and dispersion measures are eval/'s (image_eval.h, reference.h). Every
+// output is checked before the render and written only when all succeed (common/output.h); exit
+// codes as every tool's (README).
 #include <cmath>
 #include <cstdio>
-#include <functional>
 #include <sstream>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
-#include "runtime/src/bake_data.h"
 #include "common/cli/cli.h"
-#include "common/decompress.h"
 #include "common/error.h"
 #include "common/evalbuffer.h"
 #include "common/output.h"
-#include "eval/directions.h"
 #include "eval/image_eval.h"
-#include "eval/reference.h"
-#include "shrefract/baselines.h"
-#include "shrefract/context.h"
-#include "shrefract/render.h"
-#include "shrefract/runtime.h"
-#include "eval/seams.h"
+#include "eval/render_method.h"
 
 namespace {
 
@@ -50,17 +40,6 @@ std::vector<float> parseFloats(const std::string& text, size_t count, const std:
                                     text + "'");
     return v;
 }
-
-// One method, set up once: renders a camera's frame and says how long it took.
-struct Method {
-    // Draws and reads back one frame; the reference sets `ms` to its CPU wall time (a GL method's
-    // time is wallMs: its timer queries are printed per stage, but llvmpipe's miss most of its
-    // rasterizer's work).
-    std::function<RenderedFrame(const Camera&, double* ms)> render;
-    // A GL method's ms per frame as an app sees it (frameWallMs); empty for the reference.
-    std::function<double(const Camera&)> wallMs;
-    std::string timing;  // what "ms per frame" is
-};
 
 }  // namespace
 
@@ -232,156 +211,29 @@ int main(int argc, char** argv) {
             throw std::invalid_argument("--order " + std::to_string(order) + ": " + bakePath +
                                         " stores orders 0.." + std::to_string(bake.order()) +
                                         " (-1: all)");
-        std::vector<float> kappa;
         if (!absorption.empty()) {
-            kappa = parseFloats(absorption, 3, "--absorption");
+            const std::vector<float> kappa = parseFloats(absorption, 3, "--absorption");
             for (float k : kappa)
                 if (!(k >= 0.0f) || !std::isfinite(k))
                     throw std::invalid_argument("--absorption: kappa must be finite and >= 0, got '" + absorption + "'");
             sh.absorption = glm::vec3(kappa[0], kappa[1], kappa[2]);
         }
-
-        std::unique_ptr<BakeData> seamBake;  // whose seams to measure the render's jump across
-        if (!seamsOf.empty())
-            seamBake = std::make_unique<BakeData>(readBake(seamsOf));
-        else if (bakeData(bake).layout.isChartLayout())
-            seamBake = std::make_unique<BakeData>(bakeData(bake));
-        if (!seamsOf.empty() && !seamBake->layout.isChartLayout())
-            throw std::invalid_argument("--seams-of " + seamsOf + ": a joining bake has no seams");
-
-        std::unique_ptr<Scene> scene;
-        std::unique_ptr<Tracer> tracer;
-        if (method == "raytrace" || method == "wyman" || seamBake) {
-            scene = std::make_unique<Scene>(sceneOfBake(bakeData(bake), bakePath, scenePath));
-            if (!kappa.empty())
-                for (Part& p : scene->parts) p.medium.absorption = {kappa[0], kappa[1], kappa[2]};
-            tracer = std::make_unique<Tracer>(*scene, traceOptionsOfBake(bakeData(bake)));
-        }
-
-        // Set the method up once; `render` draws one camera's frame.
-        Method m;
-        std::unique_ptr<ReferenceEnvironment> envImage;
-        std::unique_ptr<HeadlessContext> context;
-        std::unique_ptr<Environment> env;
-        std::unique_ptr<Refractor> refractor, bracket;
-        std::unique_ptr<Baseline> baseline;
-        if (method == "raytrace") {
-            // The CPU reference: no GL context at all.
-            envImage = std::make_unique<ReferenceEnvironment>(loadLatLong(envPath), !latLongLookup);
-            m.timing = "CPU wall time, Embree, all cores";
-            m.render = [&](const Camera& c, double* ms) {
-                ReferenceView view;
-                view.eye = c.eye, view.target = c.target, view.up = c.up;
-                view.fovDegrees = c.fovDegrees, view.width = width, view.height = height;
-                view.spp = spp;
-                ReferenceStats stats;
-                EvalBuffer b;
-                if (ior.x > 0) {
-                    b = renderDispersed(*scene, traceOptionsOfBake(bakeData(bake)), *envImage, view, ior, &stats);
-                } else {
-                    b = renderReference(*tracer, *envImage, view, &stats);
-                }
-                RenderedFrame f;
-                f.width = width, f.height = height;
-                f.color.resize(b.pixelCount() * 4);
-                f.directions.resize(b.pixelCount() * 4);
-                for (size_t i = 0; i < b.pixelCount(); ++i) {
-                    for (int ch = 0; ch < 3; ++ch) {
-                        f.color[4 * i + ch] = b.color[i][ch];
-                        f.directions[4 * i + ch] = b.direction[i][ch];
-                    }
-                    f.color[4 * i + 3] = 1.0f;
-                    f.directions[4 * i + 3] = b.color[i].a;
-                }
-                *ms = stats.milliseconds;
-                std::printf("raytrace: %zu covered pixels; paths with TIR %zu, capped %zu, re-entered "
-                            "%zu, geometric normal %zu, back-facing first hits %zu\n",
-                            stats.covered, stats.tir, stats.capped, stats.reentered,
-                            stats.geometricNormal, stats.backFacing);
-                return f;
-            };
-        } else {
-            context = createHeadlessContext(backend, width, height);
-            std::printf("GL: %s (%s)\n", context->description().c_str(), nameOf(backend));
-            summary["renderer"] = context->description();
-            env = std::make_unique<Environment>(Environment::loadLatLong(envPath));
-            if (method == "sh") {
-                RefractorOptions options = sh;
-                options.errorModel = !noErrorModel;
-                options.order = order;
-                options.maxOrder = order;  // only the bands used go to the GPU (paper Figure 12)
-                options.smoothing = smoothing;
-                options.gutter = gutter;
-                options.seamAware = seamAware == "on";
-                options.loader = context->loader();
-                options.timings = stageTimers;
-                refractor = Refractor::create(bake, options);
-                if (ior.x > 0) {
-                    refractor->setIor(ior);
-                    if (!bracketPath.empty()) {
-                        bracket = Refractor::create(loadBake(bracketPath, !noVerify), options);
-                        refractor->setIorBracket(bracket.get());
-                    }
-                    std::printf("index of refraction %g,%g,%g from the bake's %g%s\n", ior.x, ior.y,
-                                ior.z, bake.ior(),
-                                bracket ? " and the bracketing bake's" : " and the straight path");
-                }
-                std::printf("bake: order %d, %d samples, %d triangles, %s layout, %s %dx%d; using "
-                            "order %d, %d decompression pass(es), preset %s, path %s, decompression %s, "
-                            "shading %s; GPU memory %.2f MB\n",
-                            bake.order(), bake.sampleCount(), bake.triangleCount(),
-                            bake.layout().c_str(), bake.layout() == "joining" ? "rho" : "atlas",
-                            refractor->refractionMapSize().x, refractor->refractionMapSize().y,
-                            refractor->order(), refractor->passCount(), nameOf(options.preset),
-                            nameOf(refractor->path()), nameOf(refractor->decompression()),
-                            nameOf(options.shading), refractor->memory().total() / 1e6);
-                if (bake.layout() != "joining")
-                    std::printf("charts: gutter %d texels, seam-aware %s\n", refractor->gutter(),
-                                refractor->seamAware() ? "on" : "off");
-                summary["order"] = refractor->order();
-                summary["passes"] = refractor->passCount();
-                summary["path"] = nameOf(refractor->path());
-                summary["decompression"] = nameOf(refractor->decompression());
-                summary["shading"] = nameOf(options.shading);
-                if (!dumpDir.empty()) refractor->dumpShaders(dumpDir);
-                if (bake.layout() != "joining") {  // the map's own jump across the seams
-                    refractor->update(FrameView::fromEye(cam.eye));
-                    const std::vector<float> mp = refractor->readRefractionMap();
-                    std::vector<glm::vec4> map(mp.size() / 4);
-                    for (size_t i = 0; i < map.size(); ++i)
-                        map[i] = {mp[4 * i], mp[4 * i + 1], mp[4 * i + 2], mp[4 * i + 3]};
-                    nlohmann::json st = jumpStats({}, seamJumps(bakeData(bake).layout, map));
-                    summary["mapSeams"] = st;
-                    if (st["count"].get<size_t>() > 0)
-                        std::printf("refraction map across %zu smooth seam points: jump median %.3f, "
-                                    "p95 %.3f deg\n",
-                                    st["count"].get<size_t>(), st["median"].get<double>(),
-                                    st["p95"].get<double>());
-                }
-                m.render = [&](const Camera& c, double*) {
-                    return renderFrame(*refractor, *env, c, width, height);
-                };
-                m.wallMs = [&](const Camera& c) {
-                    return frameWallMs(*refractor, *env, c, width, height, std::max(1, frames));
-                };
-            } else {
-                BaselineOptions options;
-                options.method = parseName<BaselineMethod>(method);
-                options.absorption = sh.absorption;
-                options.timings = stageTimers;
-                options.tir = tir;
-                options.loader = context->loader();
-                std::vector<float> normalDistance;
-                if (tracer) normalDistance = normalDistances(*tracer, bakeData(bake).layout);
-                baseline = Baseline::create(bake, normalDistance, options);
-                m.render = [&](const Camera& c, double*) {
-                    return renderFrame(*baseline, *env, c, width, height);
-                };
-                m.wallMs = [&](const Camera& c) {
-                    return frameWallMs(*baseline, *env, c, width, height, std::max(1, frames));
-                };
-            }
-        }
+        RenderRequest request;
+        request.method = method;
+        request.bakePath = bakePath, request.envPath = envPath, request.scenePath = scenePath;
+        request.bracketPath = bracketPath, request.seamsOf = seamsOf, request.dumpDir = dumpDir;
+        request.width = width, request.height = height, request.frames = frames, request.spp = spp;
+        request.ior = ior;
+        request.backend = backend, request.tir = tir;
+        request.latLongLookup = latLongLookup, request.verify = !noVerify;
+        request.stageTimers = stageTimers;
+        request.sh = sh;
+        request.sh.errorModel = !noErrorModel;
+        request.sh.order = order;
+        request.sh.smoothing = smoothing;
+        request.sh.gutter = gutter;
+        request.sh.seamAware = seamAware == "on";
+        RenderMethod m(request, cam, summary);  // input first (cheap, the common failure), then GL
 
         RenderedFrame frame;
         double msPerFrame = 0;
@@ -390,11 +242,10 @@ int main(int argc, char** argv) {
             // this over the 64-spp reference's). Frame 0 is the --camera view.
             std::vector<double> diffs;
             RenderedFrame previous;
-            double ms = 0;
             for (int f = 0; f < flickerFrames; ++f) {
                 Camera c = Camera::orbit(orbit[0] + f * flickerStep, orbit[1], orbit[2]);
                 c.fovDegrees = fov;
-                frame = m.render(c, &ms);
+                frame = m.render(c, &msPerFrame);
                 if (f > 0) diffs.push_back(meanAbsToneMappedDifference(previous.color, frame.color, exposure));
                 previous = frame;
             }
@@ -407,68 +258,22 @@ int main(int argc, char** argv) {
                 writeFile(stagedFlicker,
                           nlohmann::json{{"method", method}, {"frames", flickerFrames}, {"stepDeg", flickerStep},
                                          {"meanAbsDifference", mean}, {"differences", diffs}}.dump(1) + "\n");
-            msPerFrame = ms;
             summary["flicker"] = {{"frames", flickerFrames}, {"stepDeg", flickerStep},
                                   {"meanAbsDifference", mean}};
         } else {
             // The reference is traced once. A GL method draws a warm-up frame first (llvmpipe
             // JIT-compiles shaders at the first draw), so that the GPU stage times printed below
             // are those of a warm frame.
-            double ms = 0;
-            if (m.wallMs) m.render(cam, &ms);
-            frame = m.render(cam, &ms);
-            msPerFrame = ms;
-            if (refractor) {
-                const Timings& t = frame.timings;
-                if (stageTimers) {
-                    std::printf("GPU ms: view %.3f, decompress %.3f (%d passes), smooth %.3f, unpack "
-                                "%.3f, shade %.3f\n",
-                                t.view, t.decompress, t.passes, t.smooth, t.unpack, t.shade);
-                    summary["stageMs"] = {{"view", t.view}, {"decompress", t.decompress},
-                                          {"smooth", t.smooth}, {"unpack", t.unpack}, {"shade", t.shade}};
-                }
-                const GpuMemory& g = refractor->memory();
-                const double extra = bracket ? bracket->memory().total() / 1e6 : 0.0;
-                if (bracket)
-                    std::printf("GPU memory: %.1f MB + bracketing bake %.1f MB\n", g.total() / 1e6, extra);
-                else
-                    std::printf("GPU memory: %.1f MB\n", g.total() / 1e6);
-                summary["gpuMemoryMB"] = g.total() / 1e6 + extra;
-                summary["gpuMemoryPartsMB"] = {{"weights", g.weights / 1e6}, {"samples", g.samples / 1e6},
-                                               {"rho", g.rho / 1e6}, {"neighbours", g.neighbours / 1e6},
-                                               {"mesh", g.mesh / 1e6}, {"targets", g.targets / 1e6},
-                                               {"bracketingBake", extra}};
-            } else if (baseline && stageTimers) {
-                std::printf("GPU ms: back faces %.3f, shade %.3f\n", baseline->timings().backFaces,
-                            baseline->timings().shade);
-                summary["stageMs"] = {{"backFaces", baseline->timings().backFaces},
-                                      {"shade", baseline->timings().shade}};
-            }
+            if (m.timesFrames()) m.render(cam, &msPerFrame);
+            frame = m.render(cam, &msPerFrame);
+            m.reportWarmFrame(frame, summary);
         }
-        if (m.wallMs) {
-            msPerFrame = m.wallMs(cam);
-            m.timing = "wall: update + background + draw + glFinish, no read-back; median of " +
-                       std::to_string(std::max(1, frames)) + " after a warm-up";
-        }
-        std::printf("ms per frame (%s): %.3f (%s)\n", method.c_str(), msPerFrame, m.timing.c_str());
+        if (m.timesFrames()) msPerFrame = m.wallMs(cam);
+        std::printf("ms per frame (%s): %.3f (%s)\n", method.c_str(), msPerFrame, m.timing().c_str());
         summary["msPerFrame"] = msPerFrame;
-        summary["timing"] = m.timing;
-        if (seamBake) {
-            ReferenceView view;
-            view.eye = cam.eye, view.target = cam.target, view.up = cam.up;
-            view.fovDegrees = cam.fovDegrees, view.width = width, view.height = height;
-            const auto pairs = seamPixelPairs(*tracer, seamBake->layout, view);
-            nlohmann::json st = jumpStats(pairs, pairJumps(frame.directions, pairs));
-            if (st["count"].get<size_t>() > 0)
-                std::printf("seams: %zu pixel pairs straddle a smooth seam; exit direction jump mean "
-                            "%.3f, median %.3f, p95 %.3f deg\n",
-                            st["count"].get<size_t>(), st["mean"].get<double>(),
-                            st["median"].get<double>(), st["p95"].get<double>());
-            else
-                std::printf("seams: no pixel pair straddles a visible smooth seam\n");
-            if (!seamsJson.empty()) writeFile(stagedSeams, st.dump(2) + "\n");
-            summary["seams"] = st;
-        }
+        summary["timing"] = m.timing();
+        const nlohmann::json seams = m.reportSeams(frame, cam, summary);
+        if (!seamsJson.empty() && !seams.is_null()) writeFile(stagedSeams, seams.dump(2) + "\n");
         size_t covered = 0;
         for (size_t i = 3; i < frame.directions.size(); i += 4) covered += frame.directions[i] > 0;
         std::printf("coverage: %.1f%% of pixels\n", 100.0 * covered / (size_t(width) * height));

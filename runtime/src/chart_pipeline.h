@@ -33,7 +33,7 @@ public:
     ChartPipeline& operator=(const ChartPipeline&) = delete;
 
     // Pipeline
-    const char* name() const override { return "charts"; }
+    RefractorPath path() const override { return RefractorPath::Charts; }
     Decompression& decompression() override { return *decompression_; }
     void prepare() override { decompression_->compiled(settings_.order); }
     int passCount() override;

@@ -258,11 +258,7 @@ GLuint Decompression::run(glm::vec3 eyeObject, int order, bool smoothing, const 
 }
 
 std::vector<float> Decompression::readSamples(GLuint texture) const {
-    std::vector<float> all(static_cast<size_t>(muW_) * muH_ * 4);
-    glBindTexture(GL_TEXTURE_2D, texture);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, all.data());
-    glBindTexture(GL_TEXTURE_2D, 0);
+    const std::vector<float> all = readTextureRGBA(texture, muW_, muH_);
     const SurfaceLayout& L = bake_.layout;
     std::vector<float> samples(static_cast<size_t>(L.sampleCount()) * 4);
     for (int i = 0; i < L.sampleCount(); ++i) {

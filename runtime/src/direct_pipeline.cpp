@@ -19,9 +19,6 @@ DirectPipeline::DirectPipeline(const PipelineInputs& in)
       grid_(layout_, in.memory),
       decompression_(bakeData(in.bake), in.options, in.maxOrder, in.limits, in.form, grid_, in.memory) {
     const DecompressionSite site = in.options.decompression;
-    if (site == DecompressionSite::Vertex && in.options.smoothing)
-        throw std::invalid_argument(
-            "shrefract: vertex decompression needs the direct path and no smoothing");
     // A single decompression pass (the modern preset) can run in the shading's vertex shader.
     const bool onePass =
         generateDecompression(settings_.order, decompression_.limits(), decompression_.form()).passes.size() == 1;

@@ -18,13 +18,15 @@ namespace shrefract {
 
 class DirectPipeline : public Pipeline {
 public:
-    // Throws std::invalid_argument for a vertex decompression the limits or options cannot give,
+    // Throws std::invalid_argument for a vertex decompression the limits cannot give (one pass),
     // std::runtime_error on GL failure.
     explicit DirectPipeline(const PipelineInputs& in);
     ~DirectPipeline() override;
 
-    const char* name() const override { return "direct"; }
-    const char* decompressionSite() const override { return vertexMode() ? "vertex" : "texture"; }
+    RefractorPath path() const override { return RefractorPath::Direct; }
+    DecompressionSite decompressionSite() const override {
+        return vertexMode() ? DecompressionSite::Vertex : DecompressionSite::Texture;
+    }
     Decompression& decompression() override { return decompression_; }
     void prepare() override;
     int passCount() override;

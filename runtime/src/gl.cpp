@@ -110,6 +110,15 @@ void Target::destroy() {
     fbo = texture = 0;
 }
 
+std::vector<float> readTextureRGBA(GLuint texture, int w, int h) {
+    std::vector<float> out(static_cast<size_t>(w) * h * 4);
+    glBindTexture(GL_TEXTURE_2D, texture);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, out.data());
+    glBindTexture(GL_TEXTURE_2D, 0);
+    return out;
+}
+
 SavedTarget::SavedTarget() {
     glGetIntegerv(GL_VIEWPORT, viewport_);
     glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &framebuffer_);

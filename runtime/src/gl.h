@@ -9,6 +9,7 @@
 #include <GL/glcorearb.h>
 
 #include <string>
+#include <vector>
 
 namespace shrefract::gl {
 
@@ -109,6 +110,9 @@ GLuint buildProgram(const std::string& vertex, const std::string& fragment, cons
 // `data` (tightly packed rows; nullptr: undefined contents). Leaves it bound to GL_TEXTURE_2D.
 GLuint makeTexture2D(GLenum internal, int w, int h, GLenum format, GLenum type, const void* data,
                      GLenum filter);
+
+// Level 0 of a 2D texture of w x h texels, read back as RGBA floats, row-major from row 0.
+std::vector<float> readTextureRGBA(GLuint texture, int w, int h);
 
 // An RGBA32F texture and the framebuffer that renders into it (the runtime's passes' targets).
 struct Target {

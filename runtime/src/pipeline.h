@@ -77,8 +77,8 @@ struct PipelineInputs {
 class Pipeline {
 public:
     virtual ~Pipeline() = default;
-    virtual const char* name() const = 0;  // Refractor::path()
-    virtual const char* decompressionSite() const { return "texture"; }
+    virtual RefractorPath path() const = 0;
+    virtual DecompressionSite decompressionSite() const { return DecompressionSite::Texture; }
     virtual Decompression& decompression() = 0;
     // Compiles what the current order's frames need (setOrder()); throws on GL failure.
     virtual void prepare() = 0;

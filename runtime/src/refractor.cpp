@@ -52,7 +52,7 @@ std::unique_ptr<Pipeline> makePipeline(const PipelineInputs& in) {
         throw std::invalid_argument("shrefract: path \"charts\" for a joining bake (direct | rho | auto)");
     const bool direct = o.path == RefractorPath::Direct ||
                         (o.path == RefractorPath::Auto && in.limits.vertexTextureFetch);
-    if (!direct && o.decompression == DecompressionSite::Vertex)
+    if (o.decompression == DecompressionSite::Vertex && (!direct || o.smoothing))
         throw std::invalid_argument(
             "shrefract: vertex decompression needs the direct path and no smoothing");
     if (direct) return std::make_unique<DirectPipeline>(in);
@@ -222,10 +222,8 @@ void Refractor::setIorBracket(Refractor* other) {
 }
 
 glm::ivec2 Refractor::refractionMapSize() const { return impl_->pipeline->refractionMapSize(); }
-RefractorPath Refractor::path() const { return parseName<RefractorPath>(impl_->pipeline->name()); }
-DecompressionSite Refractor::decompression() const {
-    return parseName<DecompressionSite>(impl_->pipeline->decompressionSite());
-}
+RefractorPath Refractor::path() const { return impl_->pipeline->path(); }
+DecompressionSite Refractor::decompression() const { return impl_->pipeline->decompressionSite(); }
 
 void Refractor::setOrder(int L) {
     // As RefractorOptions::order: -1 is every uploaded band, above maxOrder clamps to it.
@@ -251,7 +249,6 @@ void Refractor::setSeamAware(bool on) { impl_->pipeline->setSeamAware(on); }
 bool Refractor::seamAware() const { return impl_->pipeline->seamAware(); }
 void Refractor::setTimings(bool on) {
     if (!on) impl_->timings = Timings{};
-    impl_->options.timings = on;
     impl_->timer->setEnabled(on);
 }
 bool Refractor::timingsEnabled() const { return impl_->timer->enabled(); }
@@ -289,12 +286,7 @@ std::vector<float> Refractor::readRefractionMap() {
     impl_->use();
     const GLuint t = refractionMap();
     const glm::ivec2 size = refractionMapSize();
-    std::vector<float> out(static_cast<size_t>(size.x) * size.y * 4);
-    glBindTexture(GL_TEXTURE_2D, t);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, out.data());
-    glBindTexture(GL_TEXTURE_2D, 0);
-    return out;
+    return readTextureRGBA(t, size.x, size.y);
 }
 
 }  // namespace shrefract

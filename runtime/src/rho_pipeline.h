@@ -14,7 +14,7 @@ class RhoPipeline : public Pipeline {
 public:
     explicit RhoPipeline(const PipelineInputs& in);  // throws on GL failure
 
-    const char* name() const override { return "rho"; }
+    RefractorPath path() const override { return RefractorPath::Rho; }
     Decompression& decompression() override { return decompression_; }
     void prepare() override { decompression_.compiled(settings_.order); }
     int passCount() override;

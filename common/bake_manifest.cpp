@@ -132,3 +132,33 @@ int readErrorOrder(const json& m) {
 }
 
 }  // namespace shrefract::format_internal
+
+namespace shrefract {
+
+using nlohmann::json;
+
+namespace {
+const json* firstMedium(const BakeData& d) {
+    const json& m = d.manifest;
+    if (!m.is_object() || !m.contains("media") || !m["media"].is_array() || m["media"].empty())
+        return nullptr;
+    return &m["media"][0];
+}
+}  // namespace
+
+float frontIor(const BakeData& d) {
+    const json* m = firstMedium(d);
+    if (m && m->contains("ior") && (*m)["ior"].is_number()) return (*m)["ior"].get<float>();
+    return 1.5f;
+}
+
+glm::vec3 frontAbsorption(const BakeData& d) {
+    const json* m = firstMedium(d);
+    if (m && m->contains("absorption") && (*m)["absorption"].is_array() &&
+        (*m)["absorption"].size() == 3)
+        return {(*m)["absorption"][0].get<float>(), (*m)["absorption"][1].get<float>(),
+                (*m)["absorption"][2].get<float>()};
+    return glm::vec3(0.0f);
+}
+
+}  // namespace shrefract

@@ -127,6 +127,10 @@ struct DrawCorner {
     uint32_t id;
 };
 std::vector<DrawCorner> drawCorners(const SurfaceLayout& layout);
+// The joining layout's sample grid as a triangle mesh (the direct path's and the glTF export's):
+// every triangle's regular barycentric subdivision at rate r, three sample indices per small
+// triangle; both halves of a grid cell keep the triangle's winding (corner 0 -> 1 -> 2).
+std::vector<uint32_t> refinedTriangles(const SurfaceLayout& layout);
 // The points drawCorners' ids name (joining: the samples; charts: the chart vertices), for data
 // given per drawn vertex, such as Wyman's d_N.
 void drawPoints(const SurfaceLayout& layout, std::vector<glm::vec3>* positions,
@@ -156,6 +160,12 @@ struct BakeData {
     // file, which carries no checksums).
     std::vector<std::string> warnings;
 };
+
+// The object's medium as the runtime shades it: the manifest's first medium (docs/format.md
+// "media"), its "ior" (1.5 when absent) and "absorption" kappa per object-space unit (0 when
+// absent).
+float frontIor(const BakeData& data);
+glm::vec3 frontAbsorption(const BakeData& data);
 
 struct ReadOptions {
     // Check every part and the manifest against their checksums (version 2 files). Off: faster,

@@ -58,4 +58,20 @@ void drawPoints(const SurfaceLayout& L, std::vector<glm::vec3>* positions,
     *normals = L.isChartLayout() ? L.atlas.vertexNormal : L.normal;
 }
 
+std::vector<uint32_t> refinedTriangles(const SurfaceLayout& L) {
+    const int r = L.rate;
+    std::vector<uint32_t> indices;
+    indices.reserve(static_cast<size_t>(L.triangleCount) * r * r * 3);
+    for (int t = 0; t < L.triangleCount; ++t)
+        for (int j = 0; j < r; ++j)
+            for (int i = 0; i + j < r; ++i) {
+                indices.insert(indices.end(), {L.sampleAt(t, i, j), L.sampleAt(t, i + 1, j),
+                                               L.sampleAt(t, i, j + 1)});
+                if (i + j + 1 < r)
+                    indices.insert(indices.end(), {L.sampleAt(t, i + 1, j), L.sampleAt(t, i + 1, j + 1),
+                                                   L.sampleAt(t, i, j + 1)});
+            }
+    return indices;
+}
+
 }  // namespace shrefract

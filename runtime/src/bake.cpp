@@ -30,27 +30,7 @@ int Bake::sampleCount() const { return bakeData(*this).layout.sampleCount(); }
 int Bake::triangleCount() const { return bakeData(*this).layout.triangleCount; }
 std::string Bake::layout() const { return nameOf(bakeData(*this).layout.kind); }
 
-// The first medium of the manifest is the object's (docs/format.md "media").
-static const nlohmann::json* firstMedium(const BakeData& d) {
-    const auto& m = d.manifest;
-    if (!m.is_object() || !m.contains("media") || !m["media"].is_array() || m["media"].empty())
-        return nullptr;
-    return &m["media"][0];
-}
-
-float Bake::ior() const {
-    const nlohmann::json* m = firstMedium(bakeData(*this));
-    if (m && m->contains("ior") && (*m)["ior"].is_number()) return (*m)["ior"].get<float>();
-    return 1.5f;
-}
-
-glm::vec3 Bake::absorption() const {
-    const nlohmann::json* m = firstMedium(bakeData(*this));
-    if (m && m->contains("absorption") && (*m)["absorption"].is_array() &&
-        (*m)["absorption"].size() == 3)
-        return {(*m)["absorption"][0].get<float>(), (*m)["absorption"][1].get<float>(),
-                (*m)["absorption"][2].get<float>()};
-    return glm::vec3(0.0f);
-}
+float Bake::ior() const { return frontIor(bakeData(*this)); }
+glm::vec3 Bake::absorption() const { return frontAbsorption(bakeData(*this)); }
 
 }  // namespace shrefract

@@ -28,21 +28,8 @@ DirectPipeline::DirectPipeline(const PipelineInputs& in)
     vertexRequired_ = site == DecompressionSite::Vertex;
 
     // The refined mesh: one vertex per mu sample (no attributes: gl_VertexID), and every
-    // triangle's regular barycentric subdivision at rate r as indices; both halves of a grid
-    // cell keep the triangle's winding (corner 0 -> 1 -> 2).
-    const SurfaceLayout& L = layout_;
-    const int r = L.rate;
-    std::vector<uint32_t> indices;
-    indices.reserve(static_cast<size_t>(L.triangleCount) * r * r * 3);
-    for (int t = 0; t < L.triangleCount; ++t)
-        for (int j = 0; j < r; ++j)
-            for (int i = 0; i + j < r; ++i) {
-                indices.insert(indices.end(), {L.sampleAt(t, i, j), L.sampleAt(t, i + 1, j),
-                                               L.sampleAt(t, i, j + 1)});
-                if (i + j + 1 < r)
-                    indices.insert(indices.end(), {L.sampleAt(t, i + 1, j), L.sampleAt(t, i + 1, j + 1),
-                                                   L.sampleAt(t, i, j + 1)});
-            }
+    // triangle's regular subdivision as indices (common/bakefile.h refinedTriangles).
+    const std::vector<uint32_t> indices = refinedTriangles(layout_);
     indexCount_ = static_cast<int>(indices.size());
     glGenVertexArrays(1, &vao_);
     glBindVertexArray(vao_);

@@ -1,0 +1,74 @@
+// shrefract-export: a bake (and environments) as a glTF 2.0 binary file for the web material
+// (web/) and any glTF viewer. A thin shell over common/gltf/gltf_export.h; the format is
+// docs/format.md "glTF export: SHREFRACT_sh_refraction".
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <filesystem>
+
+#include "common/bakefile.h"
+#include "common/cli/cli.h"
+#include "common/error.h"
+#include "common/gltf/gltf_export.h"
+#include "common/latlong.h"
+#include "common/output.h"
+
+using namespace shrefract;
+namespace fs = std::filesystem;
+
+int main(int argc, char** argv) {
+    CLI::App app{"shrefract-export: a bake as a glTF 2.0 binary (GLB) with the SH weights in the "
+                 "SHREFRACT_sh_refraction extension, optionally with prefiltered environments"};
+    std::string bakePath, output, name;
+    std::vector<std::string> environments;
+    int faceSize = 0;
+    bool noVerify = false;
+    app.add_option("bake", bakePath, "NAME.shrefract.exr (a joining layout); omit it to write environments only");
+    app.add_option("-o,--output", output, "the GLB to write")->required();
+    app.add_option("--environment", environments,
+                   "lat-long EXR environment(s) to add, prefiltered as the runtime does (repeatable)");
+    app.add_option("--face-size", faceSize, "environment cube face size (default: the image height / 2, as the runtime)")
+        ->check(CLI::Range(0, 4096));
+    app.add_option("--name", name, "the refraction's and the mesh's name (default: from the bake's file name)");
+    app.add_flag("--no-verify", noVerify, "skip the bake's checksums");
+    return cli::run(app, "shrefract-export", argc, argv, [&] {
+        if (bakePath.empty() && environments.empty())
+            throw std::invalid_argument("nothing to export: give a bake, --environment, or both");
+        OutputSet outputs;  // checked and staged before the work (common/output.h)
+        const std::string staged = outputs.add(output);
+        GltfExport what;
+        BakeData bake;
+        if (!bakePath.empty()) {
+            ReadOptions options;
+            options.verify = !noVerify;
+            bake = readBake(bakePath, options);
+            what.bake = &bake;
+            what.name = name;
+            if (what.name.empty()) {
+                what.name = fs::path(bakePath).filename().string();
+                const auto dot = what.name.find('.');
+                if (dot != std::string::npos && dot > 0) what.name.resize(dot);
+            }
+        }
+        for (const std::string& path : environments) {
+            GltfEnvironment e;
+            e.name = fs::path(path).stem().string();
+            e.base = cubeFromLatLong(loadLatLong(path), faceSize);
+            what.environments.push_back(std::move(e));
+        }
+        std::vector<uint8_t> glb;
+        try {
+            glb = exportGlb(what);
+        } catch (const InputError& e) {
+            throw inputError(bakePath, e.what());
+        }
+        writeFile(staged, std::string(glb.begin(), glb.end()));
+        outputs.commit();
+        std::printf("wrote %s: %.2f MB", output.c_str(), glb.size() / 1e6);
+        if (what.bake)
+            std::printf(", %d samples at order %d", bake.layout.sampleCount(), bake.order);
+        if (!environments.empty()) std::printf(", %zu environment(s)", environments.size());
+        std::printf("\n");
+        return int(cli::kOk);
+    });
+}

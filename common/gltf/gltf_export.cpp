@@ -1,0 +1,326 @@
+// The glTF export (docs/format.md "glTF export: SHREFRACT_sh_refraction"), through tinygltf.
+#include "common/gltf/gltf_export.h"
+
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+#include <stdexcept>
+
+#include <glm/gtc/packing.hpp>
+
+#include "common/error.h"
+#include "common/format_internal.h"
+#include "common/png.h"
+#include "common/prefilter.h"
+#include "common/sh.h"
+
+namespace shrefract {
+
+namespace {
+
+constexpr const char* kExtension = "SHREFRACT_sh_refraction";
+constexpr int kExtensionVersion = 1;
+
+// nlohmann's JSON as tinygltf's Value (its extension maps hold Values).
+tinygltf::Value toValue(const nlohmann::json& j) {
+    if (j.is_object()) {
+        tinygltf::Value::Object o;
+        for (auto it = j.begin(); it != j.end(); ++it) o[it.key()] = toValue(it.value());
+        return tinygltf::Value(std::move(o));
+    }
+    if (j.is_array()) {
+        tinygltf::Value::Array a;
+        for (const auto& v : j) a.push_back(toValue(v));
+        return tinygltf::Value(std::move(a));
+    }
+    if (j.is_boolean()) return tinygltf::Value(j.get<bool>());
+    if (j.is_number_integer()) return tinygltf::Value(j.get<int>());
+    if (j.is_number()) return tinygltf::Value(j.get<double>());
+    if (j.is_string()) return tinygltf::Value(j.get<std::string>());
+    return tinygltf::Value();
+}
+
+// The one binary buffer of the GLB, filled view by view (each view 4-byte aligned).
+class BinaryBuffer {
+public:
+    explicit BinaryBuffer(tinygltf::Model& model) : model_(model) { model_.buffers.emplace_back(); }
+    int view(const void* data, size_t bytes, int target = 0) {
+        std::vector<unsigned char>& b = model_.buffers[0].data;
+        b.resize((b.size() + 3) / 4 * 4, 0);
+        tinygltf::BufferView v;
+        v.buffer = 0;
+        v.byteOffset = b.size();
+        v.byteLength = bytes;
+        v.target = target;
+        const auto* p = static_cast<const unsigned char*>(data);
+        b.insert(b.end(), p, p + bytes);
+        model_.bufferViews.push_back(v);
+        return static_cast<int>(model_.bufferViews.size()) - 1;
+    }
+    int accessor(int view, int componentType, int type, size_t count, std::vector<double> lo = {},
+                 std::vector<double> hi = {}) {
+        tinygltf::Accessor a;
+        a.bufferView = view;
+        a.componentType = componentType;
+        a.type = type;
+        a.count = count;
+        a.minValues = std::move(lo);
+        a.maxValues = std::move(hi);
+        model_.accessors.push_back(a);
+        return static_cast<int>(model_.accessors.size()) - 1;
+    }
+
+private:
+    tinygltf::Model& model_;
+};
+
+// A glass material plain glTF viewers understand (transmission, IOR, and absorption as volume
+// attenuation over one object-space unit: attenuationColor = exp(-kappa)).
+int glassMaterial(tinygltf::Model& model, float ior, glm::vec3 kappa, std::vector<std::string>& used) {
+    tinygltf::Material m;
+    m.name = "glass";
+    m.pbrMetallicRoughness.metallicFactor = 0.0;
+    m.pbrMetallicRoughness.roughnessFactor = 0.0;
+    m.extensions["KHR_materials_transmission"] = toValue({{"transmissionFactor", 1.0}});
+    m.extensions["KHR_materials_ior"] = toValue({{"ior", ior}});
+    used.insert(used.end(), {"KHR_materials_transmission", "KHR_materials_ior"});
+    if (glm::any(glm::greaterThan(kappa, glm::vec3(0.0f)))) {
+        m.extensions["KHR_materials_volume"] = toValue(
+            {{"thicknessFactor", 1.0},
+             {"attenuationDistance", 1.0},
+             {"attenuationColor", {std::exp(-kappa.x), std::exp(-kappa.y), std::exp(-kappa.z)}}});
+        used.push_back("KHR_materials_volume");
+    }
+    model.materials.push_back(m);
+    return static_cast<int>(model.materials.size()) - 1;
+}
+
+// The refraction: mesh, node, atlas pages as PNG images, error model; its root-extension entry.
+nlohmann::json addRefraction(tinygltf::Model& model, BinaryBuffer& bin, const BakeData& d,
+                             const std::string& name, std::vector<std::string>& used) {
+    const SurfaceLayout& L = d.layout;
+    if (L.isChartLayout())
+        throw InputError(std::string("a ") + nameOf(L.kind) +
+                         " (chart) layout: the glTF export draws the joining layout's sample grid; "
+                         "bake with --layout joining");
+    const size_t N = static_cast<size_t>(L.sampleCount());
+    // The mesh: vertex v is sample v (and says so in _SHREFRACT_SAMPLE, exact in float below 2^24).
+    if (N > (size_t(1) << 24))
+        throw InputError(std::to_string(N) + " samples: more than a float32 sample number holds");
+    std::vector<float> pos(N * 3), nrm(N * 3);
+    std::vector<double> lo(3, INFINITY), hi(3, -INFINITY);
+    glm::vec3 blo(INFINITY), bhi(-INFINITY);
+    for (size_t i = 0; i < N; ++i)
+        for (int c = 0; c < 3; ++c) {
+            pos[i * 3 + c] = L.position[i][c];
+            nrm[i * 3 + c] = L.normal[i][c];
+            lo[c] = std::min(lo[c], double(L.position[i][c]));
+            hi[c] = std::max(hi[c], double(L.position[i][c]));
+        }
+    for (size_t i = 0; i < N; ++i) blo = glm::min(blo, L.position[i]), bhi = glm::max(bhi, L.position[i]);
+    const std::vector<uint32_t> indices = refinedTriangles(L);
+    tinygltf::Primitive prim;
+    prim.mode = TINYGLTF_MODE_TRIANGLES;
+    prim.attributes["POSITION"] =
+        bin.accessor(bin.view(pos.data(), pos.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
+                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, N, lo, hi);
+    prim.attributes["NORMAL"] =
+        bin.accessor(bin.view(nrm.data(), nrm.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
+                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, N);
+    std::vector<float> sample(N);
+    for (size_t i = 0; i < N; ++i) sample[i] = static_cast<float>(i);
+    prim.attributes["_SHREFRACT_SAMPLE"] =
+        bin.accessor(bin.view(sample.data(), sample.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
+                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, N);
+    prim.indices =
+        bin.accessor(bin.view(indices.data(), indices.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
+                     TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, indices.size());
+    const float ior = frontIor(d);
+    const glm::vec3 kappa = frontAbsorption(d);
+    prim.material = glassMaterial(model, ior, kappa, used);
+    const int refraction = 0;
+    prim.extensions[kExtension] = toValue({{"refraction", refraction}});
+    tinygltf::Mesh mesh;
+    mesh.name = name;
+    mesh.primitives.push_back(prim);
+    model.meshes.push_back(mesh);
+    tinygltf::Node node;
+    node.name = name;
+    node.mesh = static_cast<int>(model.meshes.size()) - 1;
+    model.nodes.push_back(node);
+
+    // The weights: one PNG image and texture per atlas page, nearest filtering, no mipmaps.
+    const WeightAtlas atlas = weightAtlas(d);
+    tinygltf::Sampler sampler;
+    sampler.minFilter = TINYGLTF_TEXTURE_FILTER_NEAREST;
+    sampler.magFilter = TINYGLTF_TEXTURE_FILTER_NEAREST;
+    sampler.wrapS = sampler.wrapT = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+    model.samplers.push_back(sampler);
+    nlohmann::json pages = nlohmann::json::array();
+    for (int p = 0; p < atlas.layout.pages; ++p) {
+        const std::vector<uint8_t> png =
+            encodePngRgba8(atlas.layout.pageWidth(p), atlas.layout.pageHeight(p), atlas.pages[p].data());
+        tinygltf::Image image;
+        image.name = name + "_weights_" + std::to_string(p);
+        image.mimeType = "image/png";
+        image.bufferView = bin.view(png.data(), png.size());
+        model.images.push_back(image);
+        tinygltf::Texture texture;
+        texture.source = static_cast<int>(model.images.size()) - 1;
+        texture.sampler = static_cast<int>(model.samplers.size()) - 1;
+        model.textures.push_back(texture);
+        pages.push_back(static_cast<int>(model.textures.size()) - 1);
+    }
+    const AtlasLayout& a = atlas.layout;
+    nlohmann::json r = {
+        {"name", name},
+        {"order", d.order},
+        {"coefficientCount", a.coefficients},
+        {"sampleCount", N},
+        {"tileSize", {a.tile[0], a.tile[1]}},
+        {"tilesPerRow", a.tilesPerRow},
+        {"tilesPerPage", a.tilesPerPage},
+        {"weights", pages},
+        {"scale", atlas.scale},
+        {"offset", atlas.offset},
+        {"ior", ior},
+        {"absorption", {kappa.x, kappa.y, kappa.z}},
+        {"boundsDiagonal", std::max(glm::length(bhi - blo), 1e-6f)},  // as the runtime's Refractor
+    };
+    if (d.manifest.contains("branch") && d.manifest["branch"].is_string())
+        r["branch"] = d.manifest["branch"];
+    if (d.errorOrder >= 0) {
+        r["error"] = {{"order", d.errorOrder},
+                      {"coefficientCount", d.errorCoefficientCount()},
+                      {"offset", kErrorOffset},
+                      {"bufferView", bin.view(d.errors.data(), d.errors.size() * sizeof(float))}};
+    }
+    return r;
+}
+
+// A prefiltered cube map as the runtime uploads it, RGBA half floats, level by level.
+nlohmann::json addEnvironment(BinaryBuffer& bin, const GltfEnvironment& e) {
+    const PrefilteredCube cube = prefilterCube(e.base);
+    std::vector<uint16_t> halves;
+    for (const CubeMapImage& level : cube.levels)
+        for (int f = 0; f < 6; ++f) {
+            const std::vector<float>& rgb = level.faces[f];
+            for (size_t t = 0; t < rgb.size() / 3; ++t) {
+                for (int c = 0; c < 3; ++c) halves.push_back(glm::packHalf1x16(rgb[t * 3 + c]));
+                halves.push_back(glm::packHalf1x16(1.0f));
+            }
+        }
+    return {{"name", e.name},
+            {"faceSize", e.base.faceSize},
+            {"levels", cube.levels.size()},
+            {"bufferView", bin.view(halves.data(), halves.size() * sizeof(uint16_t))}};
+}
+
+}  // namespace
+
+int AtlasLayout::pageWidth(int p) const {
+    const int onPage = std::min(tilesPerPage, coefficients - p * tilesPerPage);
+    return std::min(onPage, tilesPerRow) * tile[0];
+}
+
+int AtlasLayout::pageHeight(int p) const {
+    const int onPage = std::min(tilesPerPage, coefficients - p * tilesPerPage);
+    return (onPage + tilesPerRow - 1) / tilesPerRow * tile[1];
+}
+
+AtlasLayout atlasLayout(int K, int N, int W, int maxSide) {
+    if (K < 1 || N < 1 || W < 1) throw std::invalid_argument("atlasLayout: empty");
+    AtlasLayout a;
+    a.coefficients = K;
+    a.tile[0] = W;
+    a.tile[1] = (N + W - 1) / W;
+    if (a.tile[0] > maxSide || a.tile[1] > maxSide)
+        throw InputError("one coefficient's " + std::to_string(a.tile[0]) + " x " +
+                         std::to_string(a.tile[1]) + " texels exceed the " +
+                         std::to_string(maxSide) + " texel limit of a glTF texture here");
+    // Near-square pages: as many tile columns as rows, within the page limit.
+    const int columns = static_cast<int>(std::ceil(std::sqrt(double(K) * a.tile[1] / a.tile[0])));
+    a.tilesPerRow = std::clamp(columns, 1, maxSide / a.tile[0]);
+    const int rows = std::clamp((K + a.tilesPerRow - 1) / a.tilesPerRow, 1, maxSide / a.tile[1]);
+    a.tilesPerPage = a.tilesPerRow * rows;
+    a.pages = (K + a.tilesPerPage - 1) / a.tilesPerPage;
+    return a;
+}
+
+WeightAtlas weightAtlas(const BakeData& d, int maxSide) {
+    const int K = d.coefficientCount();
+    const int N = d.layout.sampleCount();
+    WeightAtlas out;
+    out.layout = atlasLayout(K, N, d.layout.muWidth, maxSide);
+    const AtlasLayout& a = out.layout;
+    out.scale.resize(size_t(K) * 4);
+    out.offset.resize(size_t(K) * 4);
+    const nlohmann::json& m = d.manifest;
+    if (d.precision == Precision::U8 && m.contains("u8") && m["u8"].is_object()) {
+        // The bake's own codes: its scale and offset in double precision, as the file reader
+        // dequantized them (docs/format.md "8-bit weights"), so that rounding back gives each code.
+        out.scale = m["u8"]["scale"].get<std::vector<double>>();
+        out.offset = m["u8"]["offset"].get<std::vector<double>>();
+        out.scale.resize(size_t(K) * 4), out.offset.resize(size_t(K) * 4);
+    } else {
+        const format_internal::U8Params q = format_internal::fitU8(d);
+        out.scale = q.scale, out.offset = q.offset;
+    }
+    for (int p = 0; p < a.pages; ++p)
+        out.pages.emplace_back(size_t(a.pageWidth(p)) * a.pageHeight(p) * 4, uint8_t(0));
+    for (int k = 0; k < K; ++k) {
+        const int p = k / a.tilesPerPage, j = k % a.tilesPerPage;
+        const int x0 = (j % a.tilesPerRow) * a.tile[0], y0 = (j / a.tilesPerRow) * a.tile[1];
+        const int width = a.pageWidth(p);
+        std::vector<uint8_t>& page = out.pages[p];
+        for (int i = 0; i < N; ++i) {
+            const size_t texel = size_t(y0 + i / a.tile[0]) * width + (x0 + i % a.tile[0]);
+            for (int c = 0; c < 4; ++c) {
+                const double scale = out.scale[k * 4 + c], offset = out.offset[k * 4 + c];
+                const float w = d.weights[(size_t(k) * N + i) * 4 + c];
+                page[texel * 4 + c] = static_cast<uint8_t>(format_internal::quantU8(w, scale, offset));
+            }
+        }
+    }
+    return out;
+}
+
+std::vector<uint8_t> exportGlb(const GltfExport& what) {
+    if (!what.bake && what.environments.empty())
+        throw std::invalid_argument("exportGlb: neither a bake nor an environment to export");
+    tinygltf::Model model;
+    model.asset.version = "2.0";
+    model.asset.generator = "shrefract-export";
+    BinaryBuffer bin(model);
+    std::vector<std::string> used = {kExtension};
+    nlohmann::json root = {{"version", kExtensionVersion}};
+    if (what.bake) {
+        root["refractions"] = {addRefraction(model, bin, *what.bake, what.name, used)};
+        tinygltf::Scene scene;
+        scene.name = what.name;
+        scene.nodes.push_back(0);
+        model.scenes.push_back(scene);
+        model.defaultScene = 0;
+    }
+    if (!what.environments.empty()) {
+        root["environments"] = nlohmann::json::array();
+        for (const GltfEnvironment& e : what.environments) root["environments"].push_back(addEnvironment(bin, e));
+    }
+    model.extensions[kExtension] = toValue(root);
+    std::sort(used.begin(), used.end());
+    used.erase(std::unique(used.begin(), used.end()), used.end());
+    model.extensionsUsed = used;
+    model.buffers[0].data.resize((model.buffers[0].data.size() + 3) / 4 * 4, 0);
+
+    std::ostringstream stream;
+    tinygltf::TinyGLTF writer;
+    if (!writer.WriteGltfSceneToStream(&model, stream, false, true))
+        throw IoError("tinygltf could not write the GLB");
+    const std::string s = stream.str();
+    return std::vector<uint8_t>(s.begin(), s.end());
+}
+
+}  // namespace shrefract

@@ -325,20 +325,18 @@ Mesh loadMesh(const std::string& path, MeshReport* report) {
     // OpenMesh drops faces that repeat a vertex before we see them; they count as degenerate.
     const size_t droppedRepeated = countOccurrences(omMessages, "Face has equal vertices");
 
-    Mesh mesh;
-    mesh.positions.reserve(om.n_vertices());
+    MeshArrays a;
+    a.positions.reserve(om.n_vertices());
     for (auto vh : om.vertices()) {
         const auto& p = om.point(vh);
-        if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])))
-            throwNonFinite(path, size_t(vh.idx()), 0, p[0], p[1], p[2]);
-        mesh.positions.emplace_back(p[0], p[1], p[2]);
+        a.positions.emplace_back(p[0], p[1], p[2]);
     }
-    const std::vector<uint32_t> weld = weldByPosition(mesh.positions);
+    const std::vector<uint32_t> weld = weldByPosition(a.positions);
 
     // A face OpenMesh cannot connect (complex edge or vertex) is re-added on fresh copies of
     // its vertices. Point it back at the originals so the file's connectivity survives and
-    // the edge map below sees the non-manifold edge; the copies stay unreferenced.
-    std::vector<uint32_t> original(mesh.positions.size());
+    // the edge map sees the non-manifold edge; the copies stay unreferenced.
+    std::vector<uint32_t> original(a.positions.size());
     for (auto vh : om.vertices()) {
         uint32_t v = uint32_t(vh.idx());
         original[v] = om.status(vh).fixed_nonmanifold() ? weld[v] : v;
@@ -346,10 +344,7 @@ Mesh loadMesh(const std::string& path, MeshReport* report) {
     // Corner texture coordinates: the file's per-corner ones (OBJ), else its per-vertex ones.
     const bool cornerUVs = options.check(OpenMesh::IO::Options::FaceTexCoord);
     const bool vertexUVs = !cornerUVs && options.check(OpenMesh::IO::Options::VertexTexCoord);
-    std::vector<glm::uvec3> candidates;
-    std::vector<glm::vec2> candidateUVs;
-    std::vector<bool> reconnected;
-    candidates.reserve(om.n_faces());
+    a.triangles.reserve(om.n_faces());
     for (auto fh : om.faces()) {
         glm::uvec3 t;
         glm::vec2 uv[3];
@@ -365,19 +360,47 @@ Mesh loadMesh(const std::string& path, MeshReport* report) {
             t[k++] = original[size_t(vh.idx())];
         }
         if (k == 3) {
-            candidates.push_back(t);
-            candidateUVs.insert(candidateUVs.end(), uv, uv + 3);
-            reconnected.push_back(copy);
+            a.triangles.push_back(t);
+            if (cornerUVs || vertexUVs) a.uvs.insert(a.uvs.end(), uv, uv + 3);
+            a.reconnected.push_back(copy);
         }
     }
+    a.droppedDegenerate = droppedRepeated;
+    // OpenMesh's STL reader sets the vertex-normal option from STL's facet normals; those
+    // are per face (and often zero), not vertex normals.
+    if (ext != ".stl" && options.check(OpenMesh::IO::Options::VertexNormal)) {
+        a.normals.reserve(a.positions.size());
+        for (auto vh : om.vertices()) {
+            const auto& fn = om.normal(vh);
+            a.normals.emplace_back(fn[0], fn[1], fn[2]);
+        }
+    }
+    return finishMesh(path, a, report);
+}
+
+Mesh finishMesh(const std::string& path, const MeshArrays& a, MeshReport* report) {
+    Mesh mesh;
+    mesh.positions = a.positions;
+    for (size_t v = 0; v < mesh.positions.size(); ++v) {
+        const glm::vec3& p = mesh.positions[v];
+        if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])))
+            throwNonFinite(path, v, 0, p[0], p[1], p[2]);
+    }
+    const std::vector<uint32_t> weld = weldByPosition(mesh.positions);
+    const bool withUVs = !a.uvs.empty();
+    SHREFRACT_CHECK(!withUVs || a.uvs.size() == 3 * a.triangles.size());
+    SHREFRACT_CHECK(a.reconnected.empty() || a.reconnected.size() == a.triangles.size());
+    SHREFRACT_CHECK(a.normals.empty() || a.normals.size() == a.positions.size());
 
     const glm::dvec3 extent = glm::dvec3(mesh.boundsMax()) - glm::dvec3(mesh.boundsMin());
     const double diagonal2 = glm::dot(extent, extent);
-    size_t degenerate = droppedRepeated;
+    size_t degenerate = a.droppedDegenerate;
     size_t reconnectedKept = 0;
-    mesh.triangles.reserve(candidates.size());
-    for (size_t i = 0; i < candidates.size(); ++i) {
-        const glm::uvec3& t = candidates[i];
+    mesh.triangles.reserve(a.triangles.size());
+    for (size_t i = 0; i < a.triangles.size(); ++i) {
+        const glm::uvec3& t = a.triangles[i];
+        SHREFRACT_CHECK(t.x < mesh.positions.size() && t.y < mesh.positions.size() &&
+                        t.z < mesh.positions.size());
         bool repeated = weld[t.x] == weld[t.y] || weld[t.y] == weld[t.z] || weld[t.x] == weld[t.z];
         if (repeated ||
             glm::length(faceCross(mesh.positions, t)) <= kDegenerateRelativeArea * diagonal2) {
@@ -385,9 +408,8 @@ Mesh loadMesh(const std::string& path, MeshReport* report) {
             continue;
         }
         mesh.triangles.push_back(t);
-        if (cornerUVs || vertexUVs)
-            mesh.uvs.insert(mesh.uvs.end(), &candidateUVs[3 * i], &candidateUVs[3 * i] + 3);
-        reconnectedKept += reconnected[i];
+        if (withUVs) mesh.uvs.insert(mesh.uvs.end(), &a.uvs[3 * i], &a.uvs[3 * i] + 3);
+        if (!a.reconnected.empty()) reconnectedKept += a.reconnected[i];
     }
     if (mesh.triangles.empty()) {
         throw inputError(path, degenerate > 0 ? "no triangles (all " + std::to_string(degenerate) +
@@ -450,16 +472,12 @@ Mesh loadMesh(const std::string& path, MeshReport* report) {
     };
 
     mesh.normals.resize(mesh.positions.size());
-    // OpenMesh's STL reader sets the vertex-normal option from STL's facet normals; those
-    // are per face (and often zero), not vertex normals.
-    mesh.normalsFromFile = ext != ".stl" && options.check(OpenMesh::IO::Options::VertexNormal);
+    mesh.normalsFromFile = !a.normals.empty();
     if (mesh.normalsFromFile) {
         size_t fallbacks = 0, disagree = 0, referenced = 0;
         std::vector<bool> fromFile(mesh.positions.size(), false);
-        for (auto vh : om.vertices()) {
-            size_t v = size_t(vh.idx());
-            const auto& fn = om.normal(vh);
-            glm::dvec3 n(fn[0], fn[1], fn[2]);
+        for (size_t v = 0; v < mesh.positions.size(); ++v) {
+            glm::dvec3 n(a.normals[v]);
             double len = glm::length(n);
             if (!std::isfinite(len) || len <= 0.0) {
                 mesh.normals[v] = computedNormal(v);

@@ -38,4 +38,21 @@ struct MeshReport {
 // promises: common/mesh_counts.h), empty (no triangles left), NaN/inf coordinates.
 Mesh loadMesh(const std::string& path, MeshReport* report = nullptr);
 
+// A mesh as a reader found it, before validation: what loadMesh takes from OpenMesh, and what
+// the glTF reader (common/gltf_scene.h) takes from a primitive's accessors.
+struct MeshArrays {
+    std::vector<glm::vec3> positions;
+    std::vector<glm::uvec3> triangles;  // indices into positions (the reader checks the range)
+    std::vector<glm::vec3> normals;     // per vertex, from the file; empty: computed
+    std::vector<glm::vec2> uvs;         // per triangle corner; empty: none
+    std::vector<bool> reconnected;      // per triangle: OpenMesh split it off; empty: none were
+    size_t droppedDegenerate = 0;       // faces the reader dropped for a repeated vertex
+};
+
+// The second half of loadMesh, for any reader: NaN/inf positions refused, degenerate triangles
+// skipped, topology reported, inward winding flipped, normals taken (flipped when they oppose the
+// winding) or computed, area-weighted. Same arrays, same Mesh, bit for bit, whichever file they
+// came from. Messages and warnings name `path`.
+Mesh finishMesh(const std::string& path, const MeshArrays& arrays, MeshReport* report = nullptr);
+
 }  // namespace shrefract

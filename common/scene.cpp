@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "common/error.h"
+#include "common/gltf_scene.h"
 
 namespace shrefract {
 
@@ -168,6 +169,7 @@ Scene loadJsonScene(const std::string& path, const Medium& defaultMedium) {
 
 Scene loadScene(const std::string& path, const Medium& defaultMedium) {
     if (endsWithJson(path)) return loadJsonScene(path, defaultMedium);
+    if (isGltfPath(path)) return loadGltfScene(path);
 
     // A bare mesh: one part, its medium from the caller (the command line).
     std::string problem = mediumProblem(defaultMedium);

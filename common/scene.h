@@ -30,6 +30,9 @@ struct Part {
 struct Scene {
     std::string path;  // the file given
     std::vector<Part> parts;
+    // What the loader left out or could not decide, one line each, already naming the file (glTF:
+    // primitives that are not glass, overlapping media of equal priority); tools print them.
+    std::vector<std::string> notes;
 };
 
 // What is wrong with a medium, or "" when it is fine: ior in [limits::kMinIor, kMaxIor], each
@@ -37,7 +40,9 @@ struct Scene {
 // bake file's manifest.
 std::string mediumProblem(const Medium& m);
 
-// Loads `path`: a .json scene, or a mesh file as one part with medium `defaultMedium`.
+// Loads `path`: a .json scene, a glTF file (.gltf, .glb: common/gltf_scene.h, which gives every
+// part its medium, so `defaultMedium` is not used), or a mesh file as one part with medium
+// `defaultMedium`.
 // Throws InputError naming the file on any problem (including every mesh's own errors and
 // absurd media: ior not in [1, 5], negative or non-finite absorption).
 Scene loadScene(const std::string& path, const Medium& defaultMedium = Medium());

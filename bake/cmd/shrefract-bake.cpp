@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
     bool quiet = false;
     double targetError = 0;
     std::string targetReport;
-    app.add_option("input", input, "mesh (.obj .off .ply .stl) or scene (.json)")->required();
+    app.add_option("input", input, "mesh (.obj .off .ply .stl), scene (.json) or glTF (.gltf .glb)")->required();
     app.add_option("-o,--output", output, "output file, NAME.shrefract.exr")->required();
     app.add_option("--order", opt.order, "SH order L: bands 0..L")->capture_default_str()->check(CLI::Range(0, limits::kMaxOrder));
     std::string layout = "joining", texels;
@@ -157,6 +157,7 @@ int main(int argc, char** argv) {
             Medium medium;
             medium.ior = ior;
             Scene scene = loadScene(input, medium);
+            for (const std::string& n : scene.notes) std::fprintf(stderr, "note: %s\n", n.c_str());
             for (const Part& p : scene.parts)
                 for (const std::string& w : p.report.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
 

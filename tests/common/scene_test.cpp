@@ -7,6 +7,7 @@
 #include <string>
 
 #include "common/error.h"
+#include "support/input_error.h"
 
 namespace shrefract {
 namespace {
@@ -39,16 +40,7 @@ std::string onePart(const std::string& partBody) {
 // Expects loadScene to fail with a message that starts with the scene file and contains every
 // fragment.
 void expectSceneError(const std::string& path, std::initializer_list<std::string> fragments) {
-    try {
-        loadScene(path);
-    } catch (const InputError& e) {
-        std::string what = e.what();
-        EXPECT_EQ(what.rfind(path + ": ", 0), 0u) << what;
-        for (const std::string& f : fragments)
-            EXPECT_NE(what.find(f), std::string::npos) << "'" << f << "' not in: " << what;
-        return;
-    }
-    ADD_FAILURE() << "no InputError for " << path;
+    test::expectRefused([](const std::string& p) { loadScene(p); }, path, fragments);
 }
 
 TEST(Scene, GlassWithLiquidHasTwoPartsAndPriorities) {

@@ -78,6 +78,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"ior", "tetra.off", kTetra, "--ior 0.5", "ior"},
         BadCase{"precision", "tetra.off", kTetra, "--precision f64", "precision"},
         BadCase{"scene", "scene.json", "{\"parts\": [{\"mesh\": \"tetra.off\", \"ior\": -2}]}", "", "scene.json"},
+        BadCase{"gltfnoglass", "plain.gltf", "{\"asset\": {\"version\": \"2.0\"}}", "", "plain.gltf: no glass"},
+        BadCase{"glbgarbage", "junk.glb", "glTF, but not binary glTF", "", "junk.glb: could not read glTF"},
         BadCase{"layout", "tetra.off", kTetra, "--layout spiral", "--layout"},
         BadCase{"chartrate", "tetra.off", kTetra, "--layout isolated --rate 2", "--rate is for --layout joining"},
         BadCase{"texels", "tetra.off", kTetra, "--layout isolated --texels 0x5", "--texels"},

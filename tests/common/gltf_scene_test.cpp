@@ -143,6 +143,27 @@ void expectError(const std::string& path, std::initializer_list<std::string> fra
     test::expectRefused([](const std::string& p) { loadScene(p); }, path, fragments);
 }
 
+TEST(Gltf, MugWithWaterIsTheJsonSceneBitForBit) {
+    // Two readers (OpenMesh on the OFF files, tinygltf on the binary buffer) of one scene.
+    const Scene off = loadScene(std::string(SHREFRACT_DATA_DIR) + "/scenes/mug_water.json");
+    const Scene gltf = loadScene(std::string(SHREFRACT_DATA_DIR) + "/scenes/mug_water.gltf");
+    ASSERT_EQ(gltf.parts.size(), off.parts.size());
+    for (size_t i = 0; i < off.parts.size(); ++i) {
+        const Part &a = off.parts[i], &b = gltf.parts[i];
+        EXPECT_EQ(b.name, a.name);
+        EXPECT_EQ(b.medium.ior, a.medium.ior);
+        EXPECT_EQ(b.medium.priority, a.medium.priority) << a.name;
+        EXPECT_EQ(b.medium.absorption, a.medium.absorption);
+        ASSERT_EQ(b.mesh.positions.size(), a.mesh.positions.size());
+        EXPECT_EQ(0, std::memcmp(b.mesh.positions.data(), a.mesh.positions.data(),
+                                 a.mesh.positions.size() * sizeof(glm::vec3)));
+        EXPECT_EQ(b.mesh.triangles, a.mesh.triangles);
+        EXPECT_EQ(0, std::memcmp(b.mesh.normals.data(), a.mesh.normals.data(),
+                                 a.mesh.normals.size() * sizeof(glm::vec3)));
+    }
+    EXPECT_TRUE(gltf.notes.empty());
+}
+
 TEST(Gltf, ExternalDataUriAndGlbBuffersReadTheSame) {
     Doc d = glassCube();
     Doc e = d, g = d;

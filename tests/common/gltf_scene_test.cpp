@@ -143,10 +143,14 @@ void expectError(const std::string& path, std::initializer_list<std::string> fra
     test::expectRefused([](const std::string& p) { loadScene(p); }, path, fragments);
 }
 
-TEST(Gltf, MugWithWaterIsTheJsonSceneBitForBit) {
-    // Two readers (OpenMesh on the OFF files, tinygltf on the binary buffer) of one scene.
-    const Scene off = loadScene(std::string(SHREFRACT_DATA_DIR) + "/scenes/mug_water.json");
-    const Scene gltf = loadScene(std::string(SHREFRACT_DATA_DIR) + "/scenes/mug_water.gltf");
+// Two readers (OpenMesh on the OFF files, tinygltf on the binary buffer) of one scene, written by
+// scripts/make-mug and scripts/make-teapot from the same OFF text.
+class GltfMatchesJson : public ::testing::TestWithParam<std::pair<const char*, const char*>> {};
+
+TEST_P(GltfMatchesJson, BitForBit) {
+    const std::string dir = std::string(SHREFRACT_DATA_DIR) + "/scenes/";
+    const Scene off = loadScene(dir + GetParam().first);
+    const Scene gltf = loadScene(dir + GetParam().second);
     ASSERT_EQ(gltf.parts.size(), off.parts.size());
     for (size_t i = 0; i < off.parts.size(); ++i) {
         const Part &a = off.parts[i], &b = gltf.parts[i];
@@ -162,6 +166,50 @@ TEST(Gltf, MugWithWaterIsTheJsonSceneBitForBit) {
                                  a.mesh.normals.size() * sizeof(glm::vec3)));
     }
     EXPECT_TRUE(gltf.notes.empty());
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, GltfMatchesJson,
+                         ::testing::Values(std::make_pair("mug_water.json", "mug_water.gltf"),
+                                           std::make_pair("teapot.json", "teapot.glb")),
+                         [](const auto& info) { return info.index == 0 ? "Mug" : "Teapot"; });
+
+TEST(Gltf, BlenderTumblerUnderATransformedEmpty) {
+    // Rig: scale 1.5, a turn about +y, then (0.2, 0.75, -0.1); Tumbler: up 0.002; Water: none.
+    // The tumbler's y [0, 0.09] lands on 0.75 + 1.5 * ([0, 0.09] + 0.002); its outer radius 0.035
+    // becomes 0.0525 about the vertical axis through (0.2, -0.1), whatever the turn.
+    const Scene s = loadScene(std::string(SHREFRACT_DATA_DIR) + "/scenes/blender_tumbler.glb");
+    ASSERT_EQ(s.parts.size(), 2u);
+    const Part &glass = s.parts[0], &water = s.parts[1];
+    EXPECT_EQ(glass.name, "Tumbler");
+    EXPECT_EQ(water.name, "Water");
+    EXPECT_NEAR(glass.mesh.boundsMin().y, 0.753, 1e-6);
+    EXPECT_NEAR(glass.mesh.boundsMax().y, 0.888, 1e-6);
+    float radius = 0.0f;
+    for (const glm::vec3& p : glass.mesh.positions)
+        radius = std::max(radius, glm::length(glm::vec2(p.x - 0.2f, p.z + 0.1f)));
+    EXPECT_NEAR(radius, 0.0525, 1e-6);
+    EXPECT_EQ(glass.medium.ior, 1.45);
+    EXPECT_EQ(water.medium.ior, 1.333);
+    EXPECT_EQ(glass.medium.priority, 1);
+    EXPECT_EQ(water.medium.priority, 2);  // its bounds lie inside the glass's
+    // attenuationDistance 1, attenuationColor exp(-(0.4, 0.12, 0.05)).
+    EXPECT_NEAR(water.medium.absorption.x, 0.4, 1e-12);
+    EXPECT_NEAR(water.medium.absorption.y, 0.12, 1e-12);
+    EXPECT_NEAR(water.medium.absorption.z, 0.05, 1e-12);
+    EXPECT_TRUE(glass.report.warnings.empty());
+    EXPECT_TRUE(s.notes.empty());
+}
+
+TEST(Gltf, BlenderGlassOnATableLeavesTheTableOut) {
+    const Scene s =
+        loadScene(std::string(SHREFRACT_DATA_DIR) + "/scenes/blender_glass_on_table.gltf");
+    ASSERT_EQ(s.parts.size(), 1u);
+    EXPECT_EQ(s.parts[0].name, "Sphere");
+    // The unit icosphere scaled by 0.05 about (0.1, 0.8, 0.05).
+    for (const glm::vec3& p : s.parts[0].mesh.positions)
+        EXPECT_NEAR(glm::length(p - glm::vec3(0.1f, 0.8f, 0.05f)), 0.05, 1e-6);
+    ASSERT_EQ(s.notes.size(), 1u);
+    EXPECT_NE(s.notes[0].find("left out node 'Table'"), std::string::npos) << s.notes[0];
 }
 
 TEST(Gltf, ExternalDataUriAndGlbBuffersReadTheSame) {

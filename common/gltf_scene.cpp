@@ -39,6 +39,22 @@ bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int
     return true;
 }
 
+// tinygltf's file callbacks, for regular files only: a buffer URI naming a FIFO would block in
+// tinygltf's own existence check (an fopen), a device such as /dev/zero read forever.
+bool regularFileExists(const std::string& path, void*) {
+    std::error_code ec;
+    return fs::is_regular_file(path, ec);
+}
+
+bool readRegularFile(std::vector<unsigned char>* out, std::string* err, const std::string& path,
+                     void* user) {
+    if (!regularFileExists(path, user)) {
+        if (err) *err += "'" + path + "' is not a regular file\n";
+        return false;
+    }
+    return tinygltf::ReadWholeFile(out, err, path, user);
+}
+
 // One accessor's elements, checked to lie inside their buffer.
 struct ElementView {
     const unsigned char* base = nullptr;
@@ -506,6 +522,8 @@ Scene loadGltfScene(const std::string& path) {
     if (fs::file_size(path, ec) == 0) throw inputError(path, "file is empty");
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader(skipImage, nullptr);
+    loader.SetFsCallbacks({&regularFileExists, &tinygltf::ExpandFilePath, &readRegularFile,
+                           &tinygltf::WriteWholeFile, nullptr});
     tinygltf::Model model;
     std::string err, warn;
     const bool ok = lowercaseExtension(path) == ".glb"

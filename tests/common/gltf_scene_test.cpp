@@ -5,6 +5,7 @@
 #include "common/gltf_scene.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cstring>
 #include <filesystem>
@@ -360,6 +361,17 @@ TEST(GltfRejects, MissingBuffer) {
     const std::string path = d.writeGltf("scene.gltf", "gone.bin");
     fs::remove(testDir() / "gone.bin");
     expectError(path, {"gone.bin"});
+}
+
+TEST(GltfRejects, BufferThatIsNotARegularFile) {
+    // A FIFO would block the read (tinygltf's own existence check opens it), a device such as
+    // /dev/zero read forever: only regular files are buffers.
+    Doc d = glassCube();
+    fs::remove(testDir() / "fifo.bin");  // a FIFO left by an earlier run would block the write
+    const std::string path = d.writeGltf("scene.gltf", "fifo.bin");
+    fs::remove(testDir() / "fifo.bin");
+    ASSERT_EQ(::mkfifo((testDir() / "fifo.bin").c_str(), 0600), 0);
+    expectError(path, {"fifo.bin", "not found"});
 }
 
 TEST(GltfRejects, TruncatedExternalBuffer) {

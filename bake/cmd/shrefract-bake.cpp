@@ -13,6 +13,7 @@
 #include "bake/cmd/common_cli.h"
 #include "common/cli/cli.h"
 #include "common/error.h"
+#include "common/gltf_scene.h"
 #include "common/limits.h"
 #include "common/output.h"
 
@@ -158,6 +159,9 @@ int main(int argc, char** argv) {
             medium.ior = ior;
             Scene scene = loadScene(input, medium);
             for (const std::string& n : scene.notes) std::fprintf(stderr, "note: %s\n", n.c_str());
+            if (isGltfPath(input) && app.count("--ior") > 0)
+                std::fprintf(stderr, "note: --ior is for a bare mesh: a glTF file's materials give "
+                                     "their own IOR (KHR_materials_ior, 1.5 when absent)\n");
             for (const Part& p : scene.parts)
                 for (const std::string& w : p.report.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
 

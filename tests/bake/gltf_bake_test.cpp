@@ -47,4 +47,19 @@ TEST(GltfBake, MugWithWaterBakesTheJsonScenesWeightsBitForBit) {
     }
 }
 
+TEST(GltfBake, SaysWhatItLeavesOutAndThatIorIsTheMaterials) {
+    const std::string out = tmp("glass_on_table.shrefract.exr");
+    const auto r = run(kBake + " " + kScenes + "blender_glass_on_table.gltf -o " + out + kSmall +
+                       " --ior 1.7");
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_NE(r.out.find("note: " + kScenes + "blender_glass_on_table.gltf: left out node 'Table'"),
+              std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("note: --ior is for a bare mesh"), std::string::npos) << r.out;
+    const shrefract::BakeData b = shrefract::readBake(out);
+    ASSERT_EQ(b.manifest["media"].size(), 1u);
+    EXPECT_EQ(b.manifest["media"][0]["name"], "Sphere");
+    EXPECT_EQ(b.manifest["media"][0]["ior"], 1.5);  // the material's, not --ior's
+}
+
 }  // namespace

@@ -67,11 +67,12 @@ class GltfReader {
 public:
     GltfReader(const std::string& path, const tinygltf::Model& model) : path_(path), m_(model) {}
 
-    Scene read();
+    Scene read(std::vector<GltfPlace>* places);
 
 private:
     struct Found {
         Part part;
+        GltfPlace place;
         bool explicitPriority = false;
     };
 
@@ -445,7 +446,7 @@ void GltfReader::assignPriorities(std::vector<Found>& found, std::vector<std::st
     }
 }
 
-Scene GltfReader::read() {
+Scene GltfReader::read(std::vector<GltfPlace>* places) {
     checkCompression();
     Scene scene;
     scene.path = path_;
@@ -491,6 +492,7 @@ Scene GltfReader::read() {
             }
             names.insert(name);
             found.push_back(part(n, int(k), world, name));
+            found.back().place = {n, node.mesh, int(k), world};
         }
     }
     if (found.empty()) {
@@ -505,7 +507,10 @@ Scene GltfReader::read() {
                  " and transmissionFactor > 0"));
     }
     assignPriorities(found, scene.notes);
-    for (Found& f : found) scene.parts.push_back(std::move(f.part));
+    for (Found& f : found) {
+        scene.parts.push_back(std::move(f.part));
+        if (places) places->push_back(f.place);
+    }
     return scene;
 }
 
@@ -516,7 +521,7 @@ bool isGltfPath(const std::string& path) {
     return ext == ".gltf" || ext == ".glb";
 }
 
-Scene loadGltfScene(const std::string& path) {
+Scene loadGltfScene(const std::string& path, std::vector<GltfPlace>* places) {
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) throw inputError(path, "file not found");
     if (fs::file_size(path, ec) == 0) throw inputError(path, "file is empty");
@@ -533,7 +538,7 @@ Scene loadGltfScene(const std::string& path) {
         while (!err.empty() && std::isspace(static_cast<unsigned char>(err.back()))) err.pop_back();
         throw inputError(path, "could not read glTF: " + (err.empty() ? std::string("unknown error") : err));
     }
-    return GltfReader(path, model).read();
+    return GltfReader(path, model).read(places);
 }
 
 }  // namespace shrefract

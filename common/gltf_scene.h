@@ -9,6 +9,9 @@
 #pragma once
 
 #include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
 
 #include "common/scene.h"
 
@@ -24,6 +27,12 @@ bool isGltfPath(const std::string& path);
 // malformed files, missing or truncated buffers, accessors outside their buffers or disagreeing
 // in count, indices out of range, glass primitives that are not TRIANGLES, Draco or meshopt
 // compression, absurd media, and files with no glass triangles in their scene.
-Scene loadGltfScene(const std::string& path);
+// `places`, when given, gets where each part came from, in the parts' order (for writing a bake
+// back into the file: common/gltf/gltf_export.h exportInto).
+struct GltfPlace {
+    int node = -1, mesh = -1, primitive = -1;
+    glm::dmat4 world{1.0};  // the node's world matrix in the scene: part coordinates = world * file's
+};
+Scene loadGltfScene(const std::string& path, std::vector<GltfPlace>* places = nullptr);
 
 }  // namespace shrefract

@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 int main(int argc, char** argv) {
     CLI::App app{"shrefract-export: a bake as a glTF 2.0 binary (GLB) with the SH weights in the "
                  "SHREFRACT_sh_refraction extension, optionally with prefiltered environments"};
-    std::string bakePath, output, name;
+    std::string bakePath, output, name, into;
     std::vector<std::string> environments;
     int faceSize = 0;
     bool noVerify = false;
@@ -29,11 +29,17 @@ int main(int argc, char** argv) {
                    "lat-long EXR environment(s) to add, prefiltered as the runtime does (repeatable)");
     app.add_option("--face-size", faceSize, "environment cube face size (default: the image height / 2, as the runtime)")
         ->check(CLI::Range(0, 4096));
+    app.add_option("--into", into,
+                   "the glTF scene (.gltf or .glb) the bake was made from: write it back as one GLB "
+                   "whose glass primitives carry the bake, everything else as it was");
     app.add_option("--name", name, "the refraction's and the mesh's name (default: from the bake's file name)");
     app.add_flag("--no-verify", noVerify, "skip the bake's checksums");
     return cli::run(app, "shrefract-export", argc, argv, [&] {
         if (bakePath.empty() && environments.empty())
             throw std::invalid_argument("nothing to export: give a bake, --environment, or both");
+        if (!into.empty() && bakePath.empty()) throw std::invalid_argument("--into needs the bake to write into it");
+        if (!into.empty() && fs::exists(into) && fs::exists(output) && fs::equivalent(into, output))
+            throw inputError(output, "is the --into scene: the output would overwrite its input");
         OutputSet outputs;  // checked and staged before the work (common/output.h)
         const std::string staged = outputs.add(output);
         GltfExport what;
@@ -57,10 +63,14 @@ int main(int argc, char** argv) {
             what.environments.push_back(std::move(e));
         }
         std::vector<uint8_t> glb;
-        try {
-            glb = exportGlb(what);
-        } catch (const InputError& e) {
-            throw inputError(bakePath, e.what());
+        if (!into.empty()) {
+            glb = exportInto(bake, into, what.environments);  // its errors name the scene
+        } else {
+            try {
+                glb = exportGlb(what);
+            } catch (const InputError& e) {
+                throw inputError(bakePath, e.what());
+            }
         }
         writeFile(staged, std::string(glb.begin(), glb.end()));
         outputs.commit();
@@ -68,6 +78,7 @@ int main(int argc, char** argv) {
         if (what.bake)
             std::printf(", %d samples at order %d", bake.layout.sampleCount(), bake.order);
         if (!environments.empty()) std::printf(", %zu environment(s)", environments.size());
+        if (!into.empty()) std::printf(", into the scene of %s", into.c_str());
         std::printf("\n");
         return int(cli::kOk);
     });

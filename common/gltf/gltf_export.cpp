@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <sstream>
 #include <stdexcept>
 
@@ -13,6 +14,7 @@
 
 #include "common/error.h"
 #include "common/format_internal.h"
+#include "common/gltf_scene.h"
 #include "common/png.h"
 #include "common/prefilter.h"
 #include "common/sh.h"
@@ -23,6 +25,8 @@ namespace {
 
 constexpr const char* kExtension = "SHREFRACT_sh_refraction";
 constexpr int kExtensionVersion = 1;
+
+std::vector<uint8_t> glbBytes(tinygltf::Model& model);
 
 // nlohmann's JSON as tinygltf's Value (its extension maps hold Values).
 tinygltf::Value toValue(const nlohmann::json& j) {
@@ -46,7 +50,10 @@ tinygltf::Value toValue(const nlohmann::json& j) {
 // The one binary buffer of the GLB, filled view by view (each view 4-byte aligned).
 class BinaryBuffer {
 public:
-    explicit BinaryBuffer(tinygltf::Model& model) : model_(model) { model_.buffers.emplace_back(); }
+    // fresh: a model without buffers gets its buffer 0; otherwise views go to the end of buffer 0.
+    explicit BinaryBuffer(tinygltf::Model& model, bool fresh = true) : model_(model) {
+        if (fresh) model_.buffers.emplace_back();
+    }
     int view(const void* data, size_t bytes, int target = 0) {
         std::vector<unsigned char>& b = model_.buffers[0].data;
         b.resize((b.size() + 3) / 4 * 4, 0);
@@ -98,59 +105,88 @@ int glassMaterial(tinygltf::Model& model, float ior, glm::vec3 kappa, std::vecto
     return static_cast<int>(model.materials.size()) - 1;
 }
 
-// The refraction: mesh, node, atlas pages as PNG images, error model; its root-extension entry.
-nlohmann::json addRefraction(tinygltf::Model& model, BinaryBuffer& bin, const BakeData& d,
-                             const std::string& name, std::vector<std::string>& used) {
-    const SurfaceLayout& L = d.layout;
+void checkExportable(const SurfaceLayout& L) {
     if (L.isChartLayout())
         throw InputError(std::string("a ") + nameOf(L.kind) +
                          " (chart) layout: the glTF export draws the joining layout's sample grid; "
                          "bake with --layout joining");
+    if (size_t(L.sampleCount()) > (size_t(1) << 24))
+        throw InputError(std::to_string(L.sampleCount()) +
+                         " samples: more than a float32 sample number (_SHREFRACT_SAMPLE) holds");
+}
+
+// The sample grid's triangles over the samples `part` selects (all: -1) as a primitive: each
+// vertex a sample, named in _SHREFRACT_SAMPLE, its position and normal taken from the bake's space
+// to the primitive's by `localFromBake` (normals by its inverse transpose).
+tinygltf::Primitive samplePrimitive(BinaryBuffer& bin, const SurfaceLayout& L, int part,
+                                    const glm::dmat4& localFromBake) {
     const size_t N = static_cast<size_t>(L.sampleCount());
-    // The mesh: vertex v is sample v (and says so in _SHREFRACT_SAMPLE, exact in float below 2^24).
-    if (N > (size_t(1) << 24))
-        throw InputError(std::to_string(N) + " samples: more than a float32 sample number holds");
-    std::vector<float> pos(N * 3), nrm(N * 3);
+    std::vector<uint32_t> vertexOf(N, UINT32_MAX);
+    std::vector<float> pos, nrm, sample;
     std::vector<double> lo(3, INFINITY), hi(3, -INFINITY);
-    glm::vec3 blo(INFINITY), bhi(-INFINITY);
-    for (size_t i = 0; i < N; ++i)
+    const glm::dmat3 normalFromBake = glm::transpose(glm::inverse(glm::dmat3(localFromBake)));
+    const bool identity = localFromBake == glm::dmat4(1.0);
+    for (size_t i = 0; i < N; ++i) {
+        if (part >= 0 && L.part[i] != uint32_t(part)) continue;
+        vertexOf[i] = static_cast<uint32_t>(sample.size());
+        sample.push_back(static_cast<float>(i));
+        // An identity keeps the bake's floats exactly.
+        const glm::vec3 p = identity ? L.position[i] : glm::vec3(localFromBake * glm::dvec4(L.position[i], 1.0));
+        const glm::vec3 n = identity ? L.normal[i] : glm::vec3(glm::normalize(normalFromBake * glm::dvec3(L.normal[i])));
         for (int c = 0; c < 3; ++c) {
-            pos[i * 3 + c] = L.position[i][c];
-            nrm[i * 3 + c] = L.normal[i][c];
-            lo[c] = std::min(lo[c], double(L.position[i][c]));
-            hi[c] = std::max(hi[c], double(L.position[i][c]));
+            pos.push_back(p[c]);
+            nrm.push_back(n[c]);
+            lo[c] = std::min(lo[c], double(p[c]));
+            hi[c] = std::max(hi[c], double(p[c]));
         }
-    for (size_t i = 0; i < N; ++i) blo = glm::min(blo, L.position[i]), bhi = glm::max(bhi, L.position[i]);
-    const std::vector<uint32_t> indices = refinedTriangles(L);
+    }
+    // A mirroring transform turns the winding over: turn it back.
+    const bool mirrored = glm::determinant(glm::dmat3(localFromBake)) < 0.0;
+    std::vector<uint32_t> indices;
+    const std::vector<uint32_t> all = refinedTriangles(L);
+    for (size_t t = 0; t < all.size(); t += 3) {
+        if (vertexOf[all[t]] == UINT32_MAX) continue;  // another part's
+        indices.insert(indices.end(), {vertexOf[all[t]], vertexOf[all[t + (mirrored ? 2 : 1)]],
+                                       vertexOf[all[t + (mirrored ? 1 : 2)]]});
+    }
+    const size_t V = sample.size();
     tinygltf::Primitive prim;
     prim.mode = TINYGLTF_MODE_TRIANGLES;
     prim.attributes["POSITION"] =
         bin.accessor(bin.view(pos.data(), pos.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
-                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, N, lo, hi);
+                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, V, lo, hi);
     prim.attributes["NORMAL"] =
         bin.accessor(bin.view(nrm.data(), nrm.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
-                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, N);
-    std::vector<float> sample(N);
-    for (size_t i = 0; i < N; ++i) sample[i] = static_cast<float>(i);
+                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, V);
     prim.attributes["_SHREFRACT_SAMPLE"] =
         bin.accessor(bin.view(sample.data(), sample.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
-                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, N);
+                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, V);
     prim.indices =
         bin.accessor(bin.view(indices.data(), indices.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
                      TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, indices.size());
+    nlohmann::json ext = {{"refraction", 0}};
+    if (!identity) {
+        const glm::dmat4 bakeFromLocal = glm::inverse(localFromBake);
+        std::vector<double> m;
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r) m.push_back(bakeFromLocal[c][r]);
+        ext["bakeFromLocal"] = m;
+    }
+    prim.extensions[kExtension] = toValue(ext);
+    return prim;
+}
+
+// The refraction's data: atlas pages as PNG images, scale and offset, the error model, the front
+// medium; its entry in the root extension.
+nlohmann::json addRefraction(tinygltf::Model& model, BinaryBuffer& bin, const BakeData& d,
+                             const std::string& name) {
+    const SurfaceLayout& L = d.layout;
+    checkExportable(L);
+    const size_t N = static_cast<size_t>(L.sampleCount());
+    glm::vec3 blo(INFINITY), bhi(-INFINITY);
+    for (size_t i = 0; i < N; ++i) blo = glm::min(blo, L.position[i]), bhi = glm::max(bhi, L.position[i]);
     const float ior = frontIor(d);
     const glm::vec3 kappa = frontAbsorption(d);
-    prim.material = glassMaterial(model, ior, kappa, used);
-    const int refraction = 0;
-    prim.extensions[kExtension] = toValue({{"refraction", refraction}});
-    tinygltf::Mesh mesh;
-    mesh.name = name;
-    mesh.primitives.push_back(prim);
-    model.meshes.push_back(mesh);
-    tinygltf::Node node;
-    node.name = name;
-    node.mesh = static_cast<int>(model.meshes.size()) - 1;
-    model.nodes.push_back(node);
 
     // The weights: one PNG image and texture per atlas page, nearest filtering, no mipmaps.
     const WeightAtlas atlas = weightAtlas(d);
@@ -298,7 +334,18 @@ std::vector<uint8_t> exportGlb(const GltfExport& what) {
     std::vector<std::string> used = {kExtension};
     nlohmann::json root = {{"version", kExtensionVersion}};
     if (what.bake) {
-        root["refractions"] = {addRefraction(model, bin, *what.bake, what.name, used)};
+        root["refractions"] = {addRefraction(model, bin, *what.bake, what.name)};
+        // One node, one mesh: the whole sample grid, vertex v sample v, with a plain glass material.
+        tinygltf::Primitive prim = samplePrimitive(bin, what.bake->layout, -1, glm::dmat4(1.0));
+        prim.material = glassMaterial(model, frontIor(*what.bake), frontAbsorption(*what.bake), used);
+        tinygltf::Mesh mesh;
+        mesh.name = what.name;
+        mesh.primitives.push_back(prim);
+        model.meshes.push_back(mesh);
+        tinygltf::Node node;
+        node.name = what.name;
+        node.mesh = 0;
+        model.nodes.push_back(node);
         tinygltf::Scene scene;
         scene.name = what.name;
         scene.nodes.push_back(0);
@@ -313,8 +360,125 @@ std::vector<uint8_t> exportGlb(const GltfExport& what) {
     std::sort(used.begin(), used.end());
     used.erase(std::unique(used.begin(), used.end()), used.end());
     model.extensionsUsed = used;
-    model.buffers[0].data.resize((model.buffers[0].data.size() + 3) / 4 * 4, 0);
+    return glbBytes(model);
+}
 
+namespace {
+
+// An image's encoded bytes as the file holds them (no decoding: they are written back as they are).
+bool keepEncoded(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
+                 const unsigned char* bytes, int size, void*) {
+    image->image.assign(bytes, bytes + size);
+    image->as_is = true;
+    return true;
+}
+
+std::string sniffMime(const std::vector<unsigned char>& b, const std::string& uri) {
+    if (b.size() >= 8 && b[0] == 0x89 && b[1] == 'P' && b[2] == 'N' && b[3] == 'G') return "image/png";
+    if (b.size() >= 3 && b[0] == 0xFF && b[1] == 0xD8 && b[2] == 0xFF) return "image/jpeg";
+    if (b.size() >= 12 && std::memcmp(b.data(), "RIFF", 4) == 0 && std::memcmp(b.data() + 8, "WEBP", 4) == 0)
+        return "image/webp";
+    throw InputError("image '" + uri + "' is neither PNG, JPEG nor WebP");
+}
+
+// Everything in one GLB: every buffer appended to buffer 0 (views re-pointed), and every image
+// that lives in a file or a data URI moved into a view of it, bytes unchanged.
+void gatherIntoOneBuffer(tinygltf::Model& model) {
+    std::vector<unsigned char> all;
+    std::vector<size_t> base;
+    for (const tinygltf::Buffer& b : model.buffers) {
+        all.resize((all.size() + 3) / 4 * 4, 0);
+        base.push_back(all.size());
+        all.insert(all.end(), b.data.begin(), b.data.end());
+    }
+    for (tinygltf::BufferView& v : model.bufferViews) {
+        v.byteOffset += base.at(size_t(v.buffer));
+        v.buffer = 0;
+    }
+    model.buffers.assign(1, tinygltf::Buffer());
+    model.buffers[0].data = std::move(all);
+    BinaryBuffer bin(model, false);
+    for (tinygltf::Image& image : model.images) {
+        if (image.bufferView < 0) {
+            image.mimeType = sniffMime(image.image, image.uri);
+            image.bufferView = bin.view(image.image.data(), image.image.size());
+            image.uri.clear();
+        }
+        image.image.clear();
+    }
+}
+
+}  // namespace
+
+std::vector<uint8_t> exportInto(const BakeData& bake, const std::string& scenePath,
+                                const std::vector<GltfEnvironment>& environments) {
+    checkExportable(bake.layout);
+    // The parts as the bake read them, and where each came from.
+    std::vector<GltfPlace> places;
+    const Scene scene = loadGltfScene(scenePath, &places);
+    const nlohmann::json& media = bake.manifest.contains("media") ? bake.manifest["media"] : nlohmann::json();
+    if (!media.is_array() || media.size() != scene.parts.size())
+        throw InputError("the bake has " + std::to_string(media.is_array() ? media.size() : 0) +
+                         " parts and " + scenePath + " " + std::to_string(scene.parts.size()) +
+                         " glass parts: it was not baked from this file");
+    for (size_t p = 0; p < scene.parts.size(); ++p)
+        if (media[p].value("meshChecksum", std::string()) != scene.parts[p].mesh.checksum())
+            throw InputError("glass part '" + scene.parts[p].name + "' of " + scenePath +
+                             " is not the mesh the bake traced (its checksum differs): re-bake it");
+
+    tinygltf::Model model;
+    tinygltf::TinyGLTF loader;
+    loader.SetImageLoader(keepEncoded, nullptr);
+    std::string err, warn;
+    const bool glb = scenePath.size() >= 4 && (scenePath.compare(scenePath.size() - 4, 4, ".glb") == 0 ||
+                                               scenePath.compare(scenePath.size() - 4, 4, ".GLB") == 0);
+    if (!(glb ? loader.LoadBinaryFromFile(&model, &err, &warn, scenePath)
+              : loader.LoadASCIIFromFile(&model, &err, &warn, scenePath)))
+        throw InputError("could not read " + scenePath + ": " + err);
+    gatherIntoOneBuffer(model);
+    BinaryBuffer bin(model, false);
+
+    nlohmann::json root = {{"version", kExtensionVersion}};
+    const std::string name = std::filesystem::path(scenePath).stem().string();
+    root["refractions"] = {addRefraction(model, bin, bake, name)};
+    // Each glass primitive becomes the sample grid of its part, in its node's coordinates, with
+    // its own material. A mesh several glass nodes share is copied for each but the first.
+    std::vector<int> meshUsers(model.meshes.size(), 0);
+    for (size_t p = 0; p < places.size(); ++p) {
+        const GltfPlace& at = places[p];
+        tinygltf::Node& node = model.nodes.at(size_t(at.node));
+        if (node.mesh != at.mesh) continue;  // already given its own copy
+        bool shared = false;
+        for (size_t n = 0; n < model.nodes.size(); ++n)
+            shared |= n != size_t(at.node) && model.nodes[n].mesh == at.mesh;
+        if (shared && meshUsers[size_t(at.mesh)]++ > 0) {
+            model.meshes.push_back(model.meshes[size_t(at.mesh)]);
+            node.mesh = static_cast<int>(model.meshes.size()) - 1;
+        }
+    }
+    for (size_t p = 0; p < places.size(); ++p) {
+        const GltfPlace& at = places[p];
+        const int meshIndex = model.nodes.at(size_t(at.node)).mesh;
+        tinygltf::Primitive& old = model.meshes.at(size_t(meshIndex)).primitives.at(size_t(at.primitive));
+        tinygltf::Primitive prim = samplePrimitive(bin, bake.layout, int(p), glm::inverse(at.world));
+        prim.material = old.material;
+        old = prim;
+    }
+    if (!environments.empty()) {
+        root["environments"] = nlohmann::json::array();
+        for (const GltfEnvironment& e : environments) root["environments"].push_back(addEnvironment(bin, e));
+    }
+    model.extensions[kExtension] = toValue(root);
+    if (std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(), kExtension) ==
+        model.extensionsUsed.end())
+        model.extensionsUsed.push_back(kExtension);
+    return glbBytes(model);
+}
+
+namespace {
+
+std::vector<uint8_t> glbBytes(tinygltf::Model& model) {
+    model.buffers[0].data.resize((model.buffers[0].data.size() + 3) / 4 * 4, 0);
     std::ostringstream stream;
     tinygltf::TinyGLTF writer;
     if (!writer.WriteGltfSceneToStream(&model, stream, false, true))
@@ -322,5 +486,7 @@ std::vector<uint8_t> exportGlb(const GltfExport& what) {
     const std::string s = stream.str();
     return std::vector<uint8_t>(s.begin(), s.end());
 }
+
+}  // namespace
 
 }  // namespace shrefract

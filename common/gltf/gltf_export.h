@@ -55,4 +55,13 @@ struct GltfExport {
 // tile wider than kMaxGltfTexture) and std::invalid_argument for an empty export.
 std::vector<uint8_t> exportGlb(const GltfExport& what);
 
+// The round trip (shrefract-export --into): the glTF scene the bake was made from (.gltf with its
+// files, or .glb) as one GLB in which every glass primitive is the sample grid of its part, in its
+// node's coordinates (docs/format.md "bakeFromLocal"), keeping its material; every other node,
+// mesh, material, texture and image stays as it was (images and buffers moved into the GLB's
+// binary chunk, bytes unchanged). Throws InputError when the bake was not made from this scene
+// (part count or a mesh checksum differs) or the scene cannot be read.
+std::vector<uint8_t> exportInto(const BakeData& bake, const std::string& scenePath,
+                                const std::vector<GltfEnvironment>& environments = {});
+
 }  // namespace shrefract

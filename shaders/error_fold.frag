@@ -13,13 +13,7 @@ layout(location = 0) out vec4 oD;
 
 #pragma shrefract_generated
 
-// common/prefilter.h resultantOfSigma: coth(kappa) - 1 / kappa with kappa = 1 / sigma^2.
-float resultantOfSigma(float sigma) {
-    if (sigma < 1e-3) return 1.0;  // kappa > 1e6: within float rounding of 1
-    float kappa = 1.0 / (sigma * sigma);
-    float e = exp(-2.0 * kappa);
-    return (1.0 + e) / (1.0 - e) - 1.0 / kappa;
-}
+#include "resultant.glsl"
 
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);

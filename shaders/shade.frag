@@ -35,7 +35,9 @@ in vec3 vPosition;
 in vec3 vObjectPosition;
 in vec3 vNormal;
 layout(location = 0) out vec4 oColor;
+#ifndef SHREFRACT_COLOR_ONLY  // WebGL's default framebuffer has one colour buffer
 layout(location = 1) out vec4 oDirection;
+#endif
 
 void main() {
 #ifdef SHREFRACT_DIRECT
@@ -64,5 +66,7 @@ void main() {
         c = mix(sharp, c, spread / (spread + uBlendSigma));
     }
     oColor = vec4(uToneMap ? toneMap(c, uExposure) : c, 1.0);
+#ifndef SHREFRACT_COLOR_ONLY
     oDirection = vec4(exitWorld, 1.0);
+#endif
 }

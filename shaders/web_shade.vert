@@ -1,0 +1,99 @@
+#version 330 core
+// The web material's vertex shader (web/src/material.js, docs/web.md): what shade_direct.vert
+// does with SHREFRACT_VERTEX_SH, for the glTF mesh of SHREFRACT_sh_refraction (docs/format.md
+// "glTF export"), where vertex v is sample v and carries its P and N as attributes. D is the SH
+// weights evaluated at the sample's local view direction (loop form, sh_eval.glsl, the order a
+// uniform), and with SHREFRACT_ERROR_MODEL the bake's predicted error folded into its length as
+// error_fold.frag does per mu texel. The rasterizer interpolates D barycentrically either way, so
+// every pixel gets the C++ direct path's texture-decompressed D (runtime/src/direct_pipeline.cpp).
+#include "frame.glsl"
+#include "sh_eval.glsl"
+#include "resultant.glsl"
+#ifndef SHREFRACT_WEIGHT_PAGES
+#define SHREFRACT_WEIGHT_PAGES 1
+#endif
+in vec3 position;  // the sample's P, object space
+in vec3 normal;    // its unit shading normal
+uniform mat4 uModel;
+uniform mat4 uViewProjection;
+uniform mat3 uNormalMatrix;
+uniform vec3 uEyeObject;
+uniform int uOrder;          // SH order used, <= the stored one
+// The weight atlas: coefficient k is tile k % uTilesPerPage of page k / uTilesPerPage, tiles
+// uTileSize texels, uTilesPerRow to a row; sample i is texel (i % width, i / width) of a tile.
+uniform ivec2 uTileSize;
+uniform int uTilesPerRow;
+uniform int uTilesPerPage;
+// 8-bit codes read as UNORM: value = texel * uWeightScale[k] + uWeightOffset[k] (scale x 255).
+uniform vec4 uWeightScale[SHREFRACT_SH_MAX_COUNT];
+uniform vec4 uWeightOffset[SHREFRACT_SH_MAX_COUNT];
+uniform sampler2D uWeightPage0;
+#if SHREFRACT_WEIGHT_PAGES > 1
+uniform sampler2D uWeightPage1;
+#endif
+#if SHREFRACT_WEIGHT_PAGES > 2
+uniform sampler2D uWeightPage2;
+#endif
+#if SHREFRACT_WEIGHT_PAGES > 3
+uniform sampler2D uWeightPage3;
+#endif
+#if SHREFRACT_WEIGHT_PAGES > 4
+#error "web_shade.vert: at most 4 weight pages"
+#endif
+#ifdef SHREFRACT_ERROR_MODEL
+uniform highp sampler2DArray uErrors;  // layer k: e_k per sample, red, laid out as a weight tile
+uniform int uErrorOrder;
+uniform float uErrorOffset;            // the model is ln(err + offset)
+#endif
+out vec3 vPosition;
+out vec3 vObjectPosition;  // where on the object: a seed that moves with it (jitter shading)
+out vec3 vNormal;
+out vec4 vD;
+
+vec4 weightTexel(int k, int i) {
+    int page = k / uTilesPerPage, j = k - page * uTilesPerPage;
+    ivec2 t = ivec2((j % uTilesPerRow) * uTileSize.x + i % uTileSize.x,
+                    (j / uTilesPerRow) * uTileSize.y + i / uTileSize.x);
+#if SHREFRACT_WEIGHT_PAGES > 1
+    if (page == 1) return texelFetch(uWeightPage1, t, 0);
+#endif
+#if SHREFRACT_WEIGHT_PAGES > 2
+    if (page == 2) return texelFetch(uWeightPage2, t, 0);
+#endif
+#if SHREFRACT_WEIGHT_PAGES > 3
+    if (page == 3) return texelFetch(uWeightPage3, t, 0);
+#endif
+    return texelFetch(uWeightPage0, t, 0);
+}
+
+void main() {
+    int i = gl_VertexID;
+    vec3 w = normalize(toLocalFrame(normalize(uEyeObject - position), normal));
+    float y[SHREFRACT_SH_MAX_COUNT];
+    shEvalEven(uOrder, w, y);
+    int count = (uOrder + 1) * (uOrder + 2) / 2;
+    vec4 d = vec4(0.0);
+    for (int k = 0; k < SHREFRACT_SH_MAX_COUNT; ++k) {
+        if (k >= count) break;
+        d += (weightTexel(k, i) * uWeightScale[k] + uWeightOffset[k]) * y[k];
+    }
+#ifdef SHREFRACT_ERROR_MODEL
+    shEvalEven(uErrorOrder, w, y);
+    int errorCount = (uErrorOrder + 1) * (uErrorOrder + 2) / 2;
+    float e = 0.0;
+    ivec2 t = ivec2(i % uTileSize.x, i / uTileSize.x);
+    for (int k = 0; k < SHREFRACT_SH_MAX_COUNT; ++k) {
+        if (k >= errorCount) break;
+        e += texelFetch(uErrors, ivec3(t, k), 0).r * y[k];
+    }
+    float err = max(exp(e) - uErrorOffset, 0.0);
+    float len = length(d.xyz);
+    d.xyz = (len > 1e-10 ? d.xyz / len : vec3(0.0)) * resultantOfSigma(err);
+#endif
+    vD = d;
+    vec4 world = uModel * vec4(position, 1.0);
+    vPosition = world.xyz;
+    vObjectPosition = position;
+    vNormal = uNormalMatrix * normal;
+    gl_Position = uViewProjection * world;
+}

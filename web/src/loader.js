@@ -1,0 +1,255 @@
+// SHREFRACT_sh_refraction (docs/format.md "glTF export"): a GLTFLoader plugin that reads the
+// extension's refractions and environments into three.js textures and gives each primitive that
+// names a refraction an SHRefractionMaterial. Register it with
+//   loader.register((parser) => new SHRefractionLoaderPlugin(parser));
+// Everything the file gets wrong is an Error with a message (loadAsync rejects with it).
+import * as THREE from 'three';
+import { SHRefractionMaterial } from './material.js';
+
+export const EXTENSION = 'SHREFRACT_sh_refraction';
+export const VERSION = 1;
+
+function fail(message) {
+  return new Error(`${EXTENSION}: ${message}`);
+}
+
+// A GLB's header and chunk lengths against the bytes there are: a truncated download is named
+// as such instead of failing deep inside the loader. Returns the buffer.
+export function checkGlb(buffer, what = 'GLB') {
+  const bytes = buffer.byteLength;
+  if (bytes < 20) throw new Error(`${what}: ${bytes} bytes, too short for a GLB (truncated?)`);
+  const view = new DataView(buffer);
+  if (view.getUint32(0, true) !== 0x46546c67) throw new Error(`${what}: not a GLB (no "glTF" magic)`);
+  const length = view.getUint32(8, true);
+  if (length > bytes)
+    throw new Error(`${what}: truncated: its header says ${length} bytes, ${bytes} arrived`);
+  for (let at = 12; at < length; ) {
+    if (at + 8 > length) throw new Error(`${what}: truncated chunk header at byte ${at}`);
+    const chunk = view.getUint32(at, true);
+    if (at + 8 + chunk > length)
+      throw new Error(`${what}: truncated: a chunk of ${chunk} bytes at byte ${at} runs past the end`);
+    at += 8 + chunk;
+  }
+  return buffer;
+}
+
+// Fetches a GLB, checks it (checkGlb) and parses it with `loader` (a GLTFLoader with the plugin).
+export async function loadGlb(loader, url) {
+  const response = await fetch(url);
+  if (!response.ok) throw new Error(`${url}: HTTP ${response.status}`);
+  const buffer = checkGlb(await response.arrayBuffer(), url);
+  const base = new URL('./', new URL(url, globalThis.location?.href)).href;
+  return loader.parseAsync(buffer, base);
+}
+
+function halfView(buffer, byteOffset, count) {
+  // Copies: a bufferView's offset need not be aligned to the element size.
+  const out = new Uint16Array(count);
+  new Uint8Array(out.buffer).set(new Uint8Array(buffer, byteOffset, count * 2));
+  return out;
+}
+
+function floatView(buffer, byteOffset, count) {
+  const out = new Float32Array(count);
+  new Uint8Array(out.buffer).set(new Uint8Array(buffer, byteOffset, count * 4));
+  return out;
+}
+
+// Bytes a refraction's textures take on the GPU at the formats they are uploaded in (RGBA8 weight
+// pages, R32F error layers), and its mesh's vertex and index buffers.
+export function gpuBytes(refraction, mesh = null) {
+  let textures = 0;
+  for (const t of refraction.pages) textures += t.image.width * t.image.height * 4;
+  if (refraction.error) {
+    const e = refraction.error.texture.image;
+    textures += e.width * e.height * e.depth * 4;
+  }
+  let buffers = 0;
+  if (mesh) {
+    for (const a of Object.values(mesh.geometry.attributes)) buffers += a.array.byteLength;
+    if (mesh.geometry.index) buffers += mesh.geometry.index.array.byteLength;
+  }
+  return { textures, buffers, total: textures + buffers };
+}
+
+export class SHRefractionLoaderPlugin {
+  constructor(parser, options = {}) {
+    this.name = EXTENSION;
+    this.parser = parser;
+    this.options = options;  // { environment: the app's own, maxTextureSize }
+  }
+
+  // The bytes of bufferView `index`, checked against its buffer.
+  async bufferView(index, what) {
+    const json = this.parser.json;
+    const view = (json.bufferViews || [])[index];
+    if (!view) throw fail(`${what} names bufferView ${index}, which the file lacks`);
+    const buffer = (json.buffers || [])[view.buffer];
+    const body = this.parser.extensions.KHR_binary_glTF?.body;
+    if (buffer && buffer.uri === undefined && body && body.byteLength < buffer.byteLength)
+      throw fail(`the binary chunk holds ${body.byteLength} bytes, the buffer ${buffer.byteLength} (truncated file?)`);
+    return this.parser.getDependency('bufferView', index);
+  }
+
+  // Texture index t as exact data: no colour space, no premultiplication, no flip, NEAREST.
+  async weightPage(t, what) {
+    const json = this.parser.json;
+    const texture = (json.textures || [])[t];
+    if (!texture) throw fail(`${what} names texture ${t}, which the file lacks`);
+    const image = (json.images || [])[texture.source];
+    if (!image) throw fail(`${what}: texture ${t} names image ${texture.source}, which the file lacks`);
+    let blob;
+    if (image.bufferView !== undefined) {
+      const data = await this.bufferView(image.bufferView, `${what} (image ${texture.source})`);
+      blob = new Blob([data], { type: image.mimeType || 'image/png' });
+    } else if (image.uri !== undefined) {
+      const url = THREE.LoaderUtils.resolveURL(image.uri, this.parser.options.path);
+      const response = await fetch(url);
+      if (!response.ok) throw fail(`${what}: image ${image.uri}: HTTP ${response.status}`);
+      blob = await response.blob();
+    } else {
+      throw fail(`${what}: image ${texture.source} has neither bufferView nor uri`);
+    }
+    let bitmap;
+    try {
+      bitmap = await createImageBitmap(blob, {
+        premultiplyAlpha: 'none', colorSpaceConversion: 'none', imageOrientation: 'from-image',
+      });
+    } catch (e) {
+      throw fail(`${what}: image ${texture.source} does not decode (${e.message})`);
+    }
+    const tex = new THREE.Texture(bitmap);
+    tex.flipY = false;
+    tex.premultiplyAlpha = false;
+    tex.colorSpace = THREE.NoColorSpace;
+    tex.generateMipmaps = false;
+    tex.minFilter = THREE.NearestFilter;
+    tex.magFilter = THREE.NearestFilter;
+    tex.wrapS = tex.wrapT = THREE.ClampToEdgeWrapping;
+    tex.needsUpdate = true;
+    tex.name = `${what} page`;
+    return tex;
+  }
+
+  async refraction(r, index) {
+    const what = `refraction ${index}${r.name ? ` ("${r.name}")` : ''}`;
+    for (const key of ['order', 'coefficientCount', 'sampleCount', 'tileSize', 'tilesPerRow',
+                       'tilesPerPage', 'weights', 'scale', 'offset', 'ior', 'absorption', 'boundsDiagonal'])
+      if (r[key] === undefined) throw fail(`${what} lacks "${key}"`);
+    const K = (r.order + 1) * (r.order + 2) / 2;
+    if (r.coefficientCount !== K) throw fail(`${what}: coefficientCount ${r.coefficientCount}, order ${r.order} has ${K}`);
+    const [W, H] = r.tileSize;
+    if (!(W * H >= r.sampleCount)) throw fail(`${what}: tiles of ${W} x ${H} cannot hold ${r.sampleCount} samples`);
+    if (r.scale.length !== 4 * K || r.offset.length !== 4 * K)
+      throw fail(`${what}: scale and offset need ${4 * K} numbers each`);
+    const pages = Math.ceil(K / r.tilesPerPage);
+    if (r.weights.length < pages) throw fail(`${what}: ${K} coefficients need ${pages} weight pages, it lists ${r.weights.length}`);
+    if (pages > 4) throw fail(`${what}: ${pages} weight pages; this material reads at most 4`);
+    const maxSize = this.options.maxTextureSize ?? 4096;
+    const textures = await Promise.all(r.weights.slice(0, pages).map((t, p) => this.weightPage(t, `${what} weights[${p}]`)));
+    for (const [p, tex] of textures.entries()) {
+      const { width, height } = tex.image;
+      if (width > maxSize || height > maxSize)
+        throw fail(`${what}: weight page ${p} is ${width} x ${height}, above the texture size limit ${maxSize}`);
+      const tiles = Math.min(r.tilesPerPage, K - p * r.tilesPerPage);
+      const rows = Math.ceil(tiles / r.tilesPerRow), columns = Math.min(tiles, r.tilesPerRow);
+      if (width < columns * W)
+        throw fail(`${what}: weight page ${p} is ${width} texels wide, its tiles need ${columns * W}`);
+      if (height < rows * H) throw fail(`${what}: weight page ${p} is ${height} texels high, its tiles need ${rows * H}`);
+    }
+    let error = null;
+    if (r.error) {
+      const e = r.error;
+      const Ke = (e.order + 1) * (e.order + 2) / 2;
+      if (e.coefficientCount !== Ke) throw fail(`${what}: error coefficientCount ${e.coefficientCount}, order ${e.order} has ${Ke}`);
+      if (e.order > r.order) throw fail(`${what}: error order ${e.order} above the weights' ${r.order}`);
+      const data = await this.bufferView(e.bufferView, `${what} error`);
+      const n = r.sampleCount;
+      if (data.byteLength < Ke * n * 4)
+        throw fail(`${what}: the error bufferView holds ${data.byteLength} bytes, ${Ke} x ${n} floats need ${Ke * n * 4}`);
+      const values = floatView(data, 0, Ke * n);
+      const layers = new Float32Array(W * H * Ke);  // one W x H layer per coefficient, the tile layout
+      for (let k = 0; k < Ke; ++k) layers.set(values.subarray(k * n, (k + 1) * n), k * W * H);
+      const tex = new THREE.DataArrayTexture(layers, W, H, Ke);
+      tex.format = THREE.RedFormat;
+      tex.type = THREE.FloatType;
+      tex.internalFormat = 'R32F';
+      tex.minFilter = tex.magFilter = THREE.NearestFilter;
+      tex.generateMipmaps = false;
+      tex.unpackAlignment = 1;
+      tex.needsUpdate = true;
+      error = { order: e.order, coefficientCount: Ke, offset: e.offset, texture: tex };
+    }
+    return {
+      name: r.name ?? `refraction ${index}`,
+      order: r.order, coefficientCount: K, sampleCount: r.sampleCount,
+      tileSize: [W, H], tilesPerRow: r.tilesPerRow, tilesPerPage: r.tilesPerPage,
+      pages: textures, scale: r.scale, offset: r.offset, error,
+      ior: r.ior, absorption: r.absorption, boundsDiagonal: r.boundsDiagonal, branch: r.branch,
+    };
+  }
+
+  async environment(e, index) {
+    const what = `environment ${index}${e.name ? ` ("${e.name}")` : ''}`;
+    for (const key of ['faceSize', 'levels', 'bufferView'])
+      if (e[key] === undefined) throw fail(`${what} lacks "${key}"`);
+    const data = await this.bufferView(e.bufferView, what);
+    let halves = 0;
+    for (let l = 0; l < e.levels; ++l) halves += 6 * 4 * Math.max(1, e.faceSize >> l) ** 2;
+    if (data.byteLength < halves * 2)
+      throw fail(`${what}: its bufferView holds ${data.byteLength} bytes, ${e.levels} levels of ${e.faceSize}^2 faces need ${halves * 2}`);
+    const faces = [0, 1, 2, 3, 4, 5].map(() => ({ mipmaps: [], width: e.faceSize, height: e.faceSize }));
+    let at = 0;
+    for (let l = 0; l < e.levels; ++l) {
+      const s = Math.max(1, e.faceSize >> l);
+      for (let f = 0; f < 6; ++f) {
+        faces[f].mipmaps.push({ data: halfView(data, at * 2, s * s * 4), width: s, height: s });
+        at += s * s * 4;
+      }
+    }
+    const tex = new THREE.CompressedCubeTexture(faces, THREE.RGBAFormat, THREE.HalfFloatType);
+    tex.minFilter = THREE.LinearMipmapLinearFilter;
+    tex.magFilter = THREE.LinearFilter;
+    tex.generateMipmaps = false;
+    tex.wrapS = tex.wrapT = THREE.ClampToEdgeWrapping;
+    tex.colorSpace = THREE.NoColorSpace;
+    tex.needsUpdate = true;
+    tex.name = what;
+    return { name: e.name ?? `environment ${index}`, faceSize: e.faceSize, levels: e.levels, texture: tex };
+  }
+
+  async afterRoot(result) {
+    const root = this.parser.json.extensions?.[EXTENSION];
+    const used = this.parser.json.extensionsUsed || [];
+    if (!root) {
+      if (used.includes(EXTENSION)) throw fail('listed in extensionsUsed but the root holds no extension object');
+      return;
+    }
+    if (root.version !== VERSION)
+      throw fail(`version ${JSON.stringify(root.version)}; this loader reads version ${VERSION} only`);
+    const refractions = await Promise.all((root.refractions || []).map((r, i) => this.refraction(r, i)));
+    const environments = await Promise.all((root.environments || []).map((e, i) => this.environment(e, i)));
+    const environment = this.options.environment ?? environments[0] ?? null;
+    const materials = [];
+    const meshes = [];
+    result.scene.traverse((object) => {
+      if (!object.isMesh) return;
+      const assoc = this.parser.associations.get(object);
+      if (!assoc || assoc.meshes === undefined) return;
+      const primitive = this.parser.json.meshes[assoc.meshes].primitives[assoc.primitives ?? 0];
+      const ext = primitive?.extensions?.[EXTENSION];
+      if (!ext) return;
+      const refraction = refractions[ext.refraction];
+      if (!refraction) throw fail(`mesh ${assoc.meshes} names refraction ${ext.refraction}, which the file lacks`);
+      if (!object.geometry.index) throw fail(`mesh ${assoc.meshes}: no indices (vertex v must be sample v, drawn indexed)`);
+      if (object.geometry.attributes.position.count !== refraction.sampleCount)
+        throw fail(`mesh ${assoc.meshes}: ${object.geometry.attributes.position.count} vertices, refraction ${ext.refraction} has ${refraction.sampleCount} samples`);
+      const material = new SHRefractionMaterial({ refraction, environment, ...(this.options.material || {}) });
+      object.material = material;
+      object.frustumCulled = false;
+      materials.push(material);
+      meshes.push(object);
+    });
+    result.userData.shRefraction = { refractions, environments, materials, meshes };
+  }
+}

@@ -1,0 +1,111 @@
+// SHRefractionMaterial: the C++ runtime's direct path with vertex decompression and the error
+// model folded per vertex (shaders/web_shade.vert), shaded by the C++ runtime's own fragment
+// shader (shaders/shade.frag with SHREFRACT_DIRECT, shaders/shading.glsl). Options mirror
+// RefractorOptions (runtime/include/shrefract/runtime.h); docs/web.md says what differs.
+import * as THREE from 'three';
+import { shaderSource } from './generated/shaders.js';
+import { environmentUniforms, setEnvironmentUniforms, withoutVersion } from './environment.js';
+
+const SHADINGS = ['jitter', 'spread', 'blend', 'sharp'];
+
+
+const _m3 = new THREE.Matrix3();
+const _m4 = new THREE.Matrix4();
+const _v3 = new THREE.Vector3();
+
+export class SHRefractionMaterial extends THREE.RawShaderMaterial {
+  // refraction: what SHRefractionLoaderPlugin read (result.userData.shRefraction.refractions[i]);
+  // environment: an environment it read (from this file or an environment-only one).
+  constructor({
+    refraction, environment = null, shading = 'jitter', order = -1, spreadScale = 0.15,
+    footprintScale = 0.15, jitterCell = 0.005, blendSigma = 0.1, errorModel = true,
+    toneMap = true, exposure = 1.0, absorption = null,
+  } = {}) {
+    if (!refraction) throw new Error('SHRefractionMaterial: no refraction');
+    const r = refraction;
+    const maxCount = r.coefficientCount;
+    const scale = new Float32Array(4 * maxCount), offset = new Float32Array(4 * maxCount);
+    // UNORM texels are code / 255: the scale per code times 255, as the C++ runtime's uniforms.
+    for (let i = 0; i < 4 * maxCount; ++i) {
+      scale[i] = r.scale[i] * 255;
+      offset[i] = r.offset[i];
+    }
+    const pages = r.pages.length;
+    const useError = !!(errorModel && r.error);
+    const defines = { SHREFRACT_SH_MAX_ORDER: r.order, SHREFRACT_WEIGHT_PAGES: pages };
+    if (useError) defines.SHREFRACT_ERROR_MODEL = '';
+    const uniforms = {
+      uModel: { value: new THREE.Matrix4() },
+      uViewProjection: { value: new THREE.Matrix4() },
+      uNormalMatrix: { value: new THREE.Matrix3() },
+      uModelRotation: { value: new THREE.Matrix3() },
+      uEyeObject: { value: new THREE.Vector3() },
+      uEye: { value: new THREE.Vector3() },
+      uOrder: { value: r.order },
+      uTileSize: { value: new THREE.Vector2(r.tileSize[0], r.tileSize[1]) },
+      uTilesPerRow: { value: r.tilesPerRow },
+      uTilesPerPage: { value: r.tilesPerPage },
+      uWeightScale: { value: scale },
+      uWeightOffset: { value: offset },
+      uErrors: { value: r.error ? r.error.texture : null },
+      uErrorOrder: { value: r.error ? r.error.order : 0 },
+      uErrorOffset: { value: r.error ? r.error.offset : 0.01 },
+      uEta: { value: r.ior },
+      uKappa: { value: new THREE.Vector3() },
+      uToneMap: { value: true },
+      uExposure: { value: 1 },
+      uSpread: { value: true },
+      uSpreadScale: { value: spreadScale },
+      uBlendSigma: { value: 0 },
+      uJitterCell: { value: 0 },
+      uFootprintScale: { value: footprintScale },
+      ...environmentUniforms(),
+    };
+    r.pages.forEach((t, p) => { uniforms[`uWeightPage${p}`] = { value: t }; });
+    super({
+      glslVersion: THREE.GLSL3,
+      vertexShader: withoutVersion(shaderSource('web_shade.vert', defines)),
+      fragmentShader: withoutVersion(shaderSource('shade.frag', { SHREFRACT_DIRECT: '', SHREFRACT_COLOR_ONLY: '' })),
+      uniforms,
+    });
+    this.name = `SHRefractionMaterial (${r.name})`;
+    this.refraction = r;
+    this.errorModel = useError;
+    this.shading = shading;
+    this.order = order;
+    this.spreadScale = spreadScale;
+    this.footprintScale = footprintScale;
+    this.jitterCell = jitterCell;
+    this.blendSigma = blendSigma;
+    this.toneMap = toneMap;
+    this.exposure = exposure;
+    this.absorption = absorption;  // [r, g, b] kappa instead of the bake's, or null
+    this.environment = environment;
+  }
+
+  // Per draw: the uniforms the C++ Refractor::draw and FrameUniforms set.
+  onBeforeRender(renderer, scene, camera, geometry, object) {
+    if (!SHADINGS.includes(this.shading)) throw new Error(`SHRefractionMaterial: shading "${this.shading}": ${SHADINGS.join(' | ')}`);
+    const u = this.uniforms, r = this.refraction;
+    const model = object.matrixWorld;
+    u.uModel.value.copy(model);
+    u.uViewProjection.value.multiplyMatrices(camera.projectionMatrix, camera.matrixWorldInverse);
+    u.uNormalMatrix.value.getNormalMatrix(model);
+    u.uModelRotation.value.setFromMatrix4(model);
+    _v3.setFromMatrixPosition(camera.matrixWorld);
+    u.uEye.value.copy(_v3);
+    u.uEyeObject.value.copy(_v3).applyMatrix4(_m4.copy(model).invert());
+    u.uOrder.value = this.order < 0 ? r.order : Math.min(this.order, r.order);
+    const kappa = this.absorption ?? r.absorption;
+    u.uKappa.value.set(kappa[0], kappa[1], kappa[2]);
+    u.uToneMap.value = !!this.toneMap;
+    u.uExposure.value = this.exposure;
+    u.uSpread.value = this.shading !== 'sharp';
+    u.uSpreadScale.value = this.spreadScale;
+    u.uBlendSigma.value = this.shading === 'blend' ? this.blendSigma : 0;
+    u.uJitterCell.value = this.shading === 'jitter' ? this.jitterCell * r.boundsDiagonal : 0;
+    u.uFootprintScale.value = this.footprintScale;
+    setEnvironmentUniforms(u, this.environment);
+    this.uniformsNeedUpdate = true;
+  }
+}

@@ -232,7 +232,8 @@ export class SHRefractionLoaderPlugin {
     const environment = this.options.environment ?? environments[0] ?? null;
     const materials = [];
     const meshes = [];
-    result.scene.traverse((object) => {
+    // An environment-only file has no scene.
+    for (const scene of result.scenes || []) scene.traverse((object) => {
       if (!object.isMesh) return;
       const assoc = this.parser.associations.get(object);
       if (!assoc || assoc.meshes === undefined) return;

@@ -1,0 +1,83 @@
+// Test assets: small u8 bakes (identical codes on both sides), shrefract-render's PNGs of them at
+// a few views, and their GLBs from shrefract-export, plus an environment-only GLB. Run as
+//   node assets.js --bin BUILD_DIR --out DIR [--full]
+// (the browser tests' ctest fixture; scripts/web-compare passes --full for the issue's sizes).
+// DIR/assets.json lists what is there.
+import { execFileSync } from 'node:child_process';
+import { existsSync, mkdirSync, writeFileSync, readFileSync, rmSync } from 'node:fs';
+import { dirname, join, resolve } from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+const root = resolve(dirname(fileURLToPath(import.meta.url)), '..', '..');
+
+export const ENV = 'studio';
+export const SIZE = 256;
+// shrefract-render's orbit: azimuth, elevation (degrees), distance.
+export const VIEWS = [[30, 20, 3], [150, -10, 3], [270, 45, 2.5]];
+
+// CI: a few thousand samples each, seconds to bake. Full: the issue's objects at the paper's
+// settings (35k samples, 2048 directions, order 8).
+const SMALL = {
+  knot1: ['data/meshes/knot1.off', '--rate', '1', '--order', '4', '--grid', '8x16'],
+  teapot: ['data/scenes/teapot.json', '--rate', '2', '--order', '4', '--grid', '8x16'],
+};
+const FULL = {
+  bunny00: ['data/meshes/bunny00.off', '--samples', '35000', '--order', '8', '--grid', '32x64'],
+  knot1: ['data/meshes/knot1.off', '--samples', '35000', '--order', '8', '--grid', '32x64'],
+  teapot: ['data/scenes/teapot.json', '--samples', '35000', '--order', '8', '--grid', '32x64'],
+};
+
+function tool(bin, name) {
+  for (const sub of ['bake', 'eval', 'common', 'bin', '.']) {
+    const p = join(bin, sub, name);
+    if (existsSync(p)) return p;
+  }
+  throw new Error(`${name}: not found under ${bin}`);
+}
+
+function run(exe, args) {
+  return execFileSync(exe, args, { stdio: ['ignore', 'pipe', 'pipe'], encoding: 'utf8' });
+}
+
+// fresh: start from an empty folder (the ctest fixture: a rebuilt tool must not meet old files);
+// otherwise what is there is kept (scripts/web-compare's full-size bakes take minutes).
+export function makeAssets({ bin, out, full = false, fresh = false, log = () => {} }) {
+  if (fresh) rmSync(out, { recursive: true, force: true });
+  mkdirSync(out, { recursive: true });
+  const bake = tool(bin, 'shrefract-bake'), render = tool(bin, 'shrefract-render');
+  const exporter = tool(bin, 'shrefract-export');
+  const envExr = join(root, 'data', 'envmaps', `${ENV}.exr`);
+  const envGlb = join(out, `${ENV}.glb`);
+  if (!existsSync(envGlb)) run(exporter, ['--environment', envExr, '-o', envGlb]);
+  const objects = {};
+  for (const [name, [input, ...options]] of Object.entries(full ? FULL : SMALL)) {
+    const exr = join(out, `${name}.shrefract.exr`), glb = join(out, `${name}.glb`);
+    if (!existsSync(exr)) {
+      log(`baking ${name}`);
+      run(bake, [join(root, input), '-o', exr, ...options, '--precision', 'u8', '-q', '--cache', join(out, 'cache')]);
+    }
+    if (!existsSync(glb)) run(exporter, [exr, '-o', glb]);
+    const views = [];
+    for (const [v, [az, el, dist]] of VIEWS.entries()) {
+      const png = join(out, `${name}-view${v}.png`), json = join(out, `${name}-view${v}.json`);
+      if (!existsSync(png))
+        run(render, [exr, '--env', envExr, '--size', `${SIZE}x${SIZE}`, '--camera', `orbit:${az},${el},${dist}`,
+                     '--frames', '1', '--out', png, '--json', json]);
+      views.push({ camera: [az, el, dist], png, json });
+    }
+    objects[name] = { exr, glb, views };
+  }
+  const assets = { size: SIZE, env: envGlb, envExr, objects };
+  writeFileSync(join(out, 'assets.json'), JSON.stringify(assets, null, 2));
+  return assets;
+}
+
+export function readAssets(dir) {
+  return JSON.parse(readFileSync(join(dir, 'assets.json'), 'utf8'));
+}
+
+if (process.argv[1] === fileURLToPath(import.meta.url)) {
+  const arg = (k) => { const i = process.argv.indexOf(k); return i > 0 ? process.argv[i + 1] : undefined; };
+    makeAssets({ bin: arg('--bin'), out: arg('--out'), full: process.argv.includes('--full'),
+               fresh: process.argv.includes('--fresh'), log: console.log });
+}

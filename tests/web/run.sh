@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs one browser test (web/test/NAME.js ARGS...) with node, after the shader build step; exits
-# 77 (ctest: skipped) with the reason when node, web/node_modules or chromium are missing
+# 77 (ctest: skipped) with the reason when node, the node modules of web/ or chromium are missing
 # (scripts/setup installs all three). Usage: tests/web/run.sh NAME [ARGS...]
 set -uo pipefail
 web="$(cd "$(dirname "$0")/../../web" && pwd)"

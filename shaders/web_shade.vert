@@ -1,7 +1,9 @@
 #version 330 core
 // The web material's vertex shader (web/src/material.js, docs/web.md): what shade_direct.vert
 // does with SHREFRACT_VERTEX_SH, for the glTF mesh of SHREFRACT_sh_refraction (docs/format.md
-// "glTF export"), where vertex v is sample v and carries its P and N as attributes. D is the SH
+// "glTF export"), where each vertex names its sample (_SHREFRACT_SAMPLE) and carries its P and N
+// in the primitive's own coordinates, which uBakeFromLocal takes to the bake's (identity for a bake
+// exported alone; a node's world matrix for a primitive written back into its scene). D is the SH
 // weights evaluated at the sample's local view direction (loop form, sh_eval.glsl, the order a
 // uniform), and with SHREFRACT_ERROR_MODEL the bake's predicted error folded into its length as
 // error_fold.frag does per mu texel. The rasterizer interpolates D barycentrically either way, so
@@ -12,9 +14,12 @@
 #ifndef SHREFRACT_WEIGHT_PAGES
 #define SHREFRACT_WEIGHT_PAGES 1
 #endif
-in vec3 position;  // the sample's P, object space
-in vec3 normal;    // its unit shading normal
-uniform mat4 uModel;
+in vec3 position;            // the sample's P, the primitive's coordinates
+in vec3 normal;              // its unit shading normal, likewise
+in float _shrefract_sample;  // which sample (exact in float below 2^24)
+uniform mat4 uBakeFromLocal;  // the primitive's coordinates -> the bake's ("object space" below)
+uniform mat3 uBakeNormal;     // its inverse transpose
+uniform mat4 uModel;          // the bake's space -> world
 uniform mat4 uViewProjection;
 uniform mat3 uNormalMatrix;
 uniform vec3 uEyeObject;
@@ -67,8 +72,10 @@ vec4 weightTexel(int k, int i) {
 }
 
 void main() {
-    int i = gl_VertexID;
-    vec3 w = normalize(toLocalFrame(normalize(uEyeObject - position), normal));
+    int i = int(_shrefract_sample + 0.5);
+    vec3 P = (uBakeFromLocal * vec4(position, 1.0)).xyz;
+    vec3 N = normalize(uBakeNormal * normal);
+    vec3 w = normalize(toLocalFrame(normalize(uEyeObject - P), N));
     float y[SHREFRACT_SH_MAX_COUNT];
     shEvalEven(uOrder, w, y);
     int count = (uOrder + 1) * (uOrder + 2) / 2;
@@ -91,9 +98,9 @@ void main() {
     d.xyz = (len > 1e-10 ? d.xyz / len : vec3(0.0)) * resultantOfSigma(err);
 #endif
     vD = d;
-    vec4 world = uModel * vec4(position, 1.0);
+    vec4 world = uModel * vec4(P, 1.0);
     vPosition = world.xyz;
-    vObjectPosition = position;
-    vNormal = uNormalMatrix * normal;
+    vObjectPosition = P;
+    vNormal = uNormalMatrix * N;
     gl_Position = uViewProjection * world;
 }

@@ -1,7 +1,7 @@
 // The example: ?glb=OBJECT.glb (a bake written by shrefract-export) &env=ENV.glb (an
 // environment-only GLB, shrefract-export --environment ENV.exr -o ENV.glb) &envs=A.glb,B.glb
 // (the choice offered); OrbitControls, the frame rate. The browser tests drive it too:
-// &size=WxH fixes the canvas, &camera=AZ,EL,DIST (shrefract-render's orbit), &fov=deg,
+// &size=WxH fixes the canvas, &camera=AZ,EL,DIST (shrefract-render's orbit) &target=x,y,z, &fov=deg,
 // &static=1 draws on demand only, &shading=, &order=, &errorModel=0, &exposure=.
 // window.shrefract tells the state: 'loading' | 'ready' | 'error', and the first frame's time.
 import * as THREE from 'three';
@@ -32,13 +32,16 @@ const scene = new THREE.Scene();
 const camera = new THREE.PerspectiveCamera(Number(params.get('fov') || 45), width / height);
 // shrefract-render's --camera orbit:AZ,EL,DIST around the origin (Camera::orbit), with its clip
 // planes at distance / 100 and x 100 (projectionMatrix in runtime/src/render.cpp).
+// &target=x,y,z orbits that point instead (shrefract-render --eye E --target T, E the orbit's eye).
+const target = new THREE.Vector3(...(params.get('target') || '0,0,0').split(',').map(Number));
 function orbit(az, el, distance) {
   const a = THREE.MathUtils.degToRad(az), e = THREE.MathUtils.degToRad(el);
   camera.position.set(distance * Math.cos(e) * Math.sin(a), distance * Math.sin(e), distance * Math.cos(e) * Math.cos(a));
+  camera.position.add(target);
   camera.near = 1e-2 * distance;
   camera.far = 1e2 * distance;
   camera.updateProjectionMatrix();
-  camera.lookAt(0, 0, 0);
+  camera.lookAt(target);
   camera.updateMatrixWorld();
 }
 orbit(...(params.get('camera') || '30,20,3').split(',').map(Number));
@@ -76,6 +79,9 @@ async function environment(url) {
 function useEnvironment(env) {
   background.environment = env;
   for (const m of materials) m.environment = env;
+  // The scene's other objects (a glTF scene written back with shrefract-export --into) are lit by
+  // the same environment, through three's own image-based lighting.
+  scene.environment = env ? env.texture : null;
 }
 
 // Draws one frame; never throws (the loop must survive a bad frame): errors go to the page.

@@ -242,10 +242,20 @@ export class SHRefractionLoaderPlugin {
       if (!ext) return;
       const refraction = refractions[ext.refraction];
       if (!refraction) throw fail(`mesh ${assoc.meshes} names refraction ${ext.refraction}, which the file lacks`);
-      if (!object.geometry.index) throw fail(`mesh ${assoc.meshes}: no indices (vertex v must be sample v, drawn indexed)`);
-      if (object.geometry.attributes.position.count !== refraction.sampleCount)
-        throw fail(`mesh ${assoc.meshes}: ${object.geometry.attributes.position.count} vertices, refraction ${ext.refraction} has ${refraction.sampleCount} samples`);
-      const material = new SHRefractionMaterial({ refraction, environment, ...(this.options.material || {}) });
+      const samples = object.geometry.attributes._shrefract_sample;
+      if (!samples) throw fail(`mesh ${assoc.meshes}: no _SHREFRACT_SAMPLE attribute (which sample each vertex is)`);
+      for (let v = 0; v < samples.count; ++v) {
+        const i = samples.getX(v);
+        if (!(i >= 0 && i < refraction.sampleCount && Number.isInteger(i)))
+          throw fail(`mesh ${assoc.meshes}: vertex ${v} names sample ${i}, refraction ${ext.refraction} has ${refraction.sampleCount}`);
+      }
+      let bakeFromLocal = null;
+      if (ext.bakeFromLocal !== undefined) {
+        if (!Array.isArray(ext.bakeFromLocal) || ext.bakeFromLocal.length !== 16 || !ext.bakeFromLocal.every(Number.isFinite))
+          throw fail(`mesh ${assoc.meshes}: bakeFromLocal must be 16 numbers`);
+        bakeFromLocal = new THREE.Matrix4().fromArray(ext.bakeFromLocal);  // column-major, as glTF
+      }
+      const material = new SHRefractionMaterial({ refraction, environment, bakeFromLocal, ...(this.options.material || {}) });
       object.material = material;
       object.frustumCulled = false;
       materials.push(material);

@@ -12,6 +12,7 @@ const SHADINGS = ['jitter', 'spread', 'blend', 'sharp'];
 const _m3 = new THREE.Matrix3();
 const _m4 = new THREE.Matrix4();
 const _v3 = new THREE.Vector3();
+const _model = new THREE.Matrix4();
 
 export class SHRefractionMaterial extends THREE.RawShaderMaterial {
   // refraction: what SHRefractionLoaderPlugin read (result.userData.shRefraction.refractions[i]);
@@ -19,7 +20,7 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
   constructor({
     refraction, environment = null, shading = 'jitter', order = -1, spreadScale = 0.15,
     footprintScale = 0.15, jitterCell = 0.005, blendSigma = 0.1, errorModel = true,
-    toneMap = true, exposure = 1.0, absorption = null,
+    toneMap = true, exposure = 1.0, absorption = null, bakeFromLocal = null,
   } = {}) {
     if (!refraction) throw new Error('SHRefractionMaterial: no refraction');
     const r = refraction;
@@ -35,6 +36,8 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
     const defines = { SHREFRACT_SH_MAX_ORDER: r.order, SHREFRACT_WEIGHT_PAGES: pages };
     if (useError) defines.SHREFRACT_ERROR_MODEL = '';
     const uniforms = {
+      uBakeFromLocal: { value: new THREE.Matrix4() },
+      uBakeNormal: { value: new THREE.Matrix3() },
       uModel: { value: new THREE.Matrix4() },
       uViewProjection: { value: new THREE.Matrix4() },
       uNormalMatrix: { value: new THREE.Matrix3() },
@@ -81,13 +84,19 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
     this.exposure = exposure;
     this.absorption = absorption;  // [r, g, b] kappa instead of the bake's, or null
     this.environment = environment;
+    // The primitive's coordinates -> the bake's (docs/format.md "bakeFromLocal"); identity: null.
+    this.bakeFromLocal = bakeFromLocal ? bakeFromLocal.clone() : new THREE.Matrix4();
   }
 
   // Per draw: the uniforms the C++ Refractor::draw and FrameUniforms set.
   onBeforeRender(renderer, scene, camera, geometry, object) {
     if (!SHADINGS.includes(this.shading)) throw new Error(`SHRefractionMaterial: shading "${this.shading}": ${SHADINGS.join(' | ')}`);
     const u = this.uniforms, r = this.refraction;
-    const model = object.matrixWorld;
+    // The shader works in the bake's space: positions and normals go there by bakeFromLocal, and
+    // from there to the world by matrixWorld * bakeFromLocal^-1.
+    u.uBakeFromLocal.value.copy(this.bakeFromLocal);
+    u.uBakeNormal.value.getNormalMatrix(this.bakeFromLocal);
+    const model = _model.copy(object.matrixWorld).multiply(_m4.copy(this.bakeFromLocal).invert());
     u.uModel.value.copy(model);
     u.uViewProjection.value.multiplyMatrices(camera.projectionMatrix, camera.matrixWorldInverse);
     u.uNormalMatrix.value.getNormalMatrix(model);

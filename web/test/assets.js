@@ -27,6 +27,27 @@ const FULL = {
   teapot: ['data/scenes/teapot.json', '--samples', '35000', '--order', '8', '--grid', '32x64'],
 };
 
+// The glTF round trip (issue 20): scenes the bake reads as glTF, written back with
+// shrefract-export --into. glass: primitives that get the material; others: primitives that keep
+// their own; compare: glass-only scenes, drawn by shrefract-render too.
+// camera: an orbit (azimuth, elevation, distance) around target, framing the glass (the Blender-
+// style scenes are in metres, away from the origin).
+const ROUND_TRIPS = {
+  mug_water: { input: 'data/scenes/mug_water.gltf', glass: 2, others: 0, compare: true,
+               camera: [30, 20, 3], target: [0, 0, 0] },
+  blender_tumbler: { input: 'data/scenes/blender_tumbler.glb', glass: 2, others: 0, compare: true,
+                     camera: [30, 20, 0.45], target: [0.2, 0.85, -0.1] },
+  blender_glass_on_table: { input: 'data/scenes/blender_glass_on_table.gltf', glass: 1, others: 1,
+                            compare: false, camera: [30, 25, 1.2], target: [0, 0.75, 0] },
+};
+
+// The eye of shrefract-render's orbit (runtime/src/render.cpp Camera::orbit) around target.
+function orbitEye([az, el, dist], target) {
+  const a = (az * Math.PI) / 180, e = (el * Math.PI) / 180;
+  return [dist * Math.cos(e) * Math.sin(a), dist * Math.sin(e), dist * Math.cos(e) * Math.cos(a)].map((v, i) => v + target[i]);
+}
+const ROUND_TRIP_BAKE = ['--rate', '1', '--order', '4', '--grid', '8x16'];
+
 function tool(bin, name) {
   for (const sub of ['bake', 'eval', 'common', 'bin', '.']) {
     const p = join(bin, sub, name);
@@ -67,7 +88,21 @@ export function makeAssets({ bin, out, full = false, fresh = false, log = () => 
     }
     objects[name] = { exr, glb, views };
   }
-  const assets = { size: SIZE, env: envGlb, envExr, objects };
+  const roundTrips = {};
+  if (!full) for (const [name, r] of Object.entries(ROUND_TRIPS)) {
+    const exr = join(out, `${name}.shrefract.exr`), glb = join(out, `${name}_baked.glb`);
+    if (!existsSync(exr)) {
+      log(`baking ${name}`);
+      run(bake, [join(root, r.input), '-o', exr, ...ROUND_TRIP_BAKE, '--precision', 'u8', '-q', '--cache', join(out, 'cache')]);
+    }
+    if (!existsSync(glb)) run(exporter, [exr, '--into', join(root, r.input), '-o', glb]);
+    const view = { camera: r.camera, target: r.target, png: join(out, `${name}-view0.png`) };
+    if (r.compare && !existsSync(view.png))
+      run(render, [exr, '--env', envExr, '--size', `${SIZE}x${SIZE}`, '--eye', orbitEye(r.camera, r.target).join(','),
+                   '--target', r.target.join(','), '--frames', '1', '--out', view.png]);
+    roundTrips[name] = { ...r, exr, glb, view: r.compare ? view : null };
+  }
+  const assets = { size: SIZE, env: envGlb, envExr, objects, roundTrips };
   writeFileSync(join(out, 'assets.json'), JSON.stringify(assets, null, 2));
   return assets;
 }

@@ -7,7 +7,8 @@ import { readAssets } from './assets.js';
 
 const arg = (k, d) => { const i = process.argv.indexOf(k); return i > 0 ? process.argv[i + 1] : d; };
 const assets = readAssets(arg('--assets'));
-const files = [assets.env, ...Object.values(assets.objects).map((o) => o.glb)];
+const files = [assets.env, ...Object.values(assets.objects).map((o) => o.glb),
+               ...Object.values(assets.roundTrips || {}).map((o) => o.glb)];
 let failed = false;
 for (const file of files) {
   const report = await validator.validateBytes(new Uint8Array(readFileSync(file)), { maxIssues: 100 });

@@ -1,10 +1,12 @@
 #include "eval/image_eval.h"
 
+#include <png.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 
 #include "eval/directions.h"
@@ -216,25 +218,26 @@ double ssim(const std::vector<float>& a, const std::vector<float>& b, int w, int
     return wholeSsim(ssimMap(a, b, w, h), w);
 }
 
-nlohmann::json compareImages(const EvalBuffer& ref, const EvalBuffer& test, float exposure) {
-    checkSameSize(ref, test);
+namespace {
+
+// The colour keys of compareImages (psnr, psnrInterior, errorShare, ssim and the object keys):
+// the tone-mapped colours cRef and cTest compared over the frame, the reference's interior and
+// silhouette, and the object mask (the pixels the reference covers). `ref` gives the coverage only.
+nlohmann::json colourMetrics(const EvalBuffer& ref, const std::vector<glm::vec3>& cRef,
+                             const std::vector<glm::vec3>& cTest) {
     const int w = ref.width, h = ref.height;
-    const std::vector<float> e = angularErrors(ref, test);
-    const std::vector<glm::vec3> cRef = toneMappedColors(ref, exposure), cTest = toneMappedColors(test, exposure);
-    std::vector<double> angles;
-    size_t cr = 0, ct = 0, both = 0, refOnly = 0, testOnly = 0;
+    size_t cr = 0;
     double se = 0, seObject = 0;
     std::vector<float> la(ref.pixelCount()), lb(ref.pixelCount());
-    for (size_t i = 0; i < e.size(); ++i) {
-        const bool a = ref.covered(i), b = test.covered(i);
-        cr += a, ct += b, both += a && b, refOnly += a && !b, testOnly += b && !a;
-        if (e[i] >= 0) angles.push_back(e[i]);
+    for (size_t i = 0; i < ref.pixelCount(); ++i) {
+        const bool a = ref.covered(i);
+        cr += a;
         const glm::vec3 d = cRef[i] - cTest[i];
         se += glm::dot(d, d);
         if (a) seObject += glm::dot(d, d);
         la[i] = luminance(cRef[i]), lb[i] = luminance(cTest[i]);
     }
-    const double mse = se / (3.0 * std::max<size_t>(1, e.size()));
+    const double mse = se / (3.0 * std::max<size_t>(1, ref.pixelCount()));
     const double psnr = mse > 0 ? 10.0 * std::log10(1.0 / mse) : 99.0;  // 99: identical
     // Where the squared error lies: silhouette pixels (the reference's coverage changes within
     // their 3 x 3 neighbourhood: the GL methods draw one sample per pixel there), the object's
@@ -270,13 +273,7 @@ nlohmann::json compareImages(const EvalBuffer& ref, const EvalBuffer& test, floa
         sumDetailRef += detailRef[i], sumDetailTest += detailTest[i], sumFlipObject += flip[i];
     }
     const double nan = std::nan(""), mseObject = seObject / (3.0 * std::max<size_t>(1, cr));
-    return {{"width", ref.width},
-            {"height", ref.height},
-            {"angleDeg", errorStats(angles)},
-            {"coverage",
-             {{"ref", cr}, {"test", ct}, {"both", both}, {"refOnly", refOnly},
-              {"testOnly", testOnly}, {"mismatch", refOnly + testOnly}}},
-            {"psnr", psnr},
+    return {{"psnr", psnr},
             {"psnrInterior", mseInterior > 0 ? 10.0 * std::log10(1.0 / mseInterior) : 99.0},
             {"errorShare",
              {{"silhouette", seClass[0] / seAll}, {"interior", seClass[1] / seAll},
@@ -287,6 +284,69 @@ nlohmann::json compareImages(const EvalBuffer& ref, const EvalBuffer& test, floa
             {"detailRatio", numberOrNull(sumDetailRef > 0 ? sumDetailTest / sumDetailRef : nan)},
             {"objectFlip", numberOrNull(cr == 0 ? nan : sumFlipObject / cr)},
             {"flip", sumFlip / std::max<size_t>(1, flip.size())}};
+}
+
+}  // namespace
+
+nlohmann::json compareImages(const EvalBuffer& ref, const EvalBuffer& test, float exposure) {
+    checkSameSize(ref, test);
+    const std::vector<float> e = angularErrors(ref, test);
+    std::vector<double> angles;
+    size_t cr = 0, ct = 0, both = 0, refOnly = 0, testOnly = 0;
+    for (size_t i = 0; i < e.size(); ++i) {
+        const bool a = ref.covered(i), b = test.covered(i);
+        cr += a, ct += b, both += a && b, refOnly += a && !b, testOnly += b && !a;
+        if (e[i] >= 0) angles.push_back(e[i]);
+    }
+    nlohmann::json r = colourMetrics(ref, toneMappedColors(ref, exposure), toneMappedColors(test, exposure));
+    r["width"] = ref.width;
+    r["height"] = ref.height;
+    r["angleDeg"] = errorStats(angles);
+    r["coverage"] = {{"ref", cr}, {"test", ct}, {"both", both}, {"refOnly", refOnly},
+                     {"testOnly", testOnly}, {"mismatch", refOnly + testOnly}};
+    return r;
+}
+
+nlohmann::json compareDisplayImage(const EvalBuffer& ref, const Image8& test, float exposure) {
+    if (ref.width != test.width || ref.height != test.height)
+        throw InputError("image sizes differ: " + std::to_string(ref.width) + "x" + std::to_string(ref.height) +
+                         " vs " + std::to_string(test.width) + "x" + std::to_string(test.height));
+    std::vector<glm::vec3> cTest(ref.pixelCount());
+    for (size_t i = 0; i < cTest.size(); ++i)
+        cTest[i] = glm::vec3(test.rgb[3 * i], test.rgb[3 * i + 1], test.rgb[3 * i + 2]) / 255.0f;
+    size_t cr = 0;
+    for (size_t i = 0; i < ref.pixelCount(); ++i) cr += ref.covered(i);
+    nlohmann::json r = colourMetrics(ref, toneMappedColors(ref, exposure), cTest);
+    r["width"] = ref.width;
+    r["height"] = ref.height;
+    r["coverage"] = {{"ref", cr}};
+    return r;
+}
+
+Image8 readPng8(const std::string& path) {
+    png_image png;
+    std::memset(&png, 0, sizeof png);
+    png.version = PNG_IMAGE_VERSION;
+    if (!png_image_begin_read_from_file(&png, path.c_str()))
+        throw InputError(path + ": not a readable PNG (" + png.message + ")");
+    if (png.format & PNG_FORMAT_FLAG_LINEAR) {
+        png_image_free(&png);
+        throw InputError(path + ": a 16-bit PNG; expected 8 bits per channel (a display image)");
+    }
+    // As RGBA and the alpha dropped here: 8-bit sRGB output is never premultiplied, so the colour
+    // is the file's whatever its alpha (a browser's canvas may leave alpha below 1).
+    png.format = PNG_FORMAT_RGBA;
+    std::vector<uint8_t> rgba(PNG_IMAGE_SIZE(png));
+    if (!png_image_finish_read(&png, nullptr, rgba.data(), 0, nullptr)) {
+        const std::string message = png.message;
+        png_image_free(&png);
+        throw InputError(path + ": cannot decode the PNG (" + message + ")");
+    }
+    Image8 out;
+    out.resize(static_cast<int>(png.width), static_cast<int>(png.height));
+    for (size_t i = 0; i < out.rgb.size() / 3; ++i)
+        for (int c = 0; c < 3; ++c) out.rgb[3 * i + c] = rgba[4 * i + c];
+    return out;
 }
 
 glm::u8vec3 errorColor(float degrees, float maxDegrees) {

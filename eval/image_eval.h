@@ -45,6 +45,18 @@ std::vector<float> angularErrors(const EvalBuffer& ref, const EvalBuffer& test);
 // if the sizes differ.
 nlohmann::json compareImages(const EvalBuffer& ref, const EvalBuffer& test, float exposure = 1.0f);
 
+// compareImages for a test that is a display image only (e.g. a browser's frame read back as a
+// PNG): its pixels / 255 are taken as the tone-mapped colours and compared with the reference's
+// toneMapAces(colour) by the colour keys of compareImages (psnr, psnrInterior, errorShare, ssim,
+// objectPsnr, objectSsim, detailRatio, objectFlip, flip), the object mask being the reference's
+// coverage; width, height and coverage {ref}. No angleDeg: an image has no exit directions.
+// Throws InputError if the sizes differ.
+nlohmann::json compareDisplayImage(const EvalBuffer& ref, const Image8& test, float exposure = 1.0f);
+
+// An 8-bit PNG (grey or colour, with or without alpha; the alpha is dropped, not composited) as
+// RGB, row 0 at the top. InputError naming the file when it is not a PNG or has 16-bit channels.
+Image8 readPng8(const std::string& path);
+
 // Mean SSIM of two single-channel images in [0, 1] (the definition above); exposed for tests.
 double ssim(const std::vector<float>& a, const std::vector<float>& b, int width, int height);
 

@@ -3,6 +3,7 @@
 //   query BAKE --in Q.csv --out A.csv                        exit direction per (point, view)
 //   image --ref A.exr --test B.exr [--heatmap H.png] [--flip-map F.png] [--json R.json]
 //                                                            two evaluation buffers
+//   image --ref A.exr --test-png B.png [--json R.json]       a buffer and a display image
 //   montage --out M.png IMG.exr... [--labels L...] [--errors] [--flip]   labelled side by side
 //   compose R.exr G.exr B.exr --out D.exr    colour channel c of input c (dispersion)
 #include <CLI/CLI.hpp>
@@ -119,11 +120,15 @@ int main(int argc, char** argv) {
     query->add_option("--max-distance", maxDistance,
                       "refuse points farther than this from the surface, object units (default: "
                       "0.001 of the bake's bounding-box diagonal)");
-    std::string refPath, testPath, heatPath, flipPath, outPng;
+    std::string refPath, testPath, testPngPath, heatPath, flipPath, outPng;
     float maxDeg = 30.0f, exposure = 1.0f;
     auto* image = app.add_subcommand("image", "compare two render evaluation buffers (docs/evaluation.md)");
     image->add_option("--ref", refPath, "reference evaluation buffer EXR (shrefract-render --dirs)")->required();
-    image->add_option("--test", testPath, "tested evaluation buffer EXR")->required();
+    auto* testOpt = image->add_option("--test", testPath, "tested evaluation buffer EXR");
+    image->add_option("--test-png", testPngPath,
+                      "or a tested 8-bit display image (tone-mapped, sRGB-encoded, e.g. a browser's "
+                      "frame): colour and object metrics only, no directions")
+        ->excludes(testOpt);
     image->add_option("--heatmap", heatPath, "angular error heat map PNG");
     image->add_option("--flip-map", flipPath, "LDR-FLIP heat map PNG of the tone-mapped images (0 ... 1)");
     image->add_option("--max-deg", maxDeg, "heat map: degrees at the top of the ramp")->capture_default_str();
@@ -153,6 +158,29 @@ int main(int argc, char** argv) {
         if (image->parsed()) {
             const std::string stagedHeat = heatPath.empty() ? "" : outputs.add(heatPath);
             const std::string stagedFlip = flipPath.empty() ? "" : outputs.add(flipPath);
+            if (testPath.empty() == testPngPath.empty())
+                throw InputError("image: give --test (an evaluation buffer) or --test-png (a display image)");
+            if (!testPngPath.empty()) {
+                if (!heatPath.empty() || !flipPath.empty())
+                    throw InputError("image: --heatmap and --flip-map need --test (a PNG has no directions)");
+                nlohmann::json r = compareDisplayImage(readEvalBuffer(refPath), readPng8(testPngPath), exposure);
+                r["ref"] = refPath;
+                r["test"] = testPngPath;
+                auto number = [](const nlohmann::json& v, int digits) {
+                    char s[32] = "-";
+                    if (!v.is_null()) std::snprintf(s, sizeof s, "%.*f", digits, v.get<double>());
+                    return std::string(s);
+                };
+                std::printf("tone-mapped: PSNR %.2f dB, SSIM %.4f, FLIP %.4f\n", r["psnr"].get<double>(),
+                            r["ssim"].get<double>(), r["flip"].get<double>());
+                std::printf("object (reference coverage, %zu pixels): PSNR %s dB, SSIM %s, FLIP %s, detail ratio %s\n",
+                            r["coverage"]["ref"].get<size_t>(), number(r["objectPsnr"], 2).c_str(),
+                            number(r["objectSsim"], 4).c_str(), number(r["objectFlip"], 4).c_str(),
+                            number(r["detailRatio"], 3).c_str());
+                if (!jsonPath.empty()) writeFile(stagedJson, r.dump(2) + "\n");
+                outputs.commit();
+                return cli::kOk;
+            }
             EvalBuffer ref = readEvalBuffer(refPath), test = readEvalBuffer(testPath);
             nlohmann::json r = compareImages(ref, test, exposure);
             r["ref"] = refPath;

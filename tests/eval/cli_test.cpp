@@ -6,6 +6,8 @@
 #include <string>
 
 #include "common/bakefile.h"
+#include "common/evalbuffer.h"
+#include "eval/image_eval.h"
 #include "support/cli_run.h"
 
 namespace {
@@ -100,6 +102,39 @@ TEST(EvalCli, EveryToolSharesTheExitCodes) {
     EXPECT_EQ(r.code, 2) << r.out;
     EXPECT_NE(r.out.find("shrefract-render: error: " + tmp("missing.shrefract.exr") + ": file not found"),
               std::string::npos) << r.out;
+}
+
+// image --test-png: a reference buffer against a display image; the report has the colour and
+// object keys, and the options that need directions are refused with a reason.
+TEST(EvalCli, ImageComparesABufferWithADisplayPng) {
+    fs::create_directories(tmp(""));
+    shrefract::EvalBuffer ref;
+    ref.width = 6, ref.height = 4;
+    for (int i = 0; i < 24; ++i) {
+        ref.color.emplace_back(0.5f, 0.5f, 0.5f, i < 12 ? 1.0f : 0.0f);
+        ref.direction.emplace_back(0, 0, i < 12 ? 1 : 0);
+    }
+    shrefract::writeEvalBuffer(tmp("png_ref.exr"), ref);
+    shrefract::Image8 png;
+    png.resize(6, 4, 100);
+    shrefract::writePng8(tmp("png_test.png"), png);
+    CommandResult r = run(kEval + " image --ref " + tmp("png_ref.exr") + " --test-png " + tmp("png_test.png") +
+                          " --json " + tmp("png_report.json"));
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_NE(r.out.find("object (reference coverage, 12 pixels): PSNR"), std::string::npos) << r.out;
+    std::ifstream report(tmp("png_report.json"));
+    const std::string text((std::istreambuf_iterator<char>(report)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("\"objectFlip\""), std::string::npos) << text;
+    EXPECT_EQ(text.find("\"angleDeg\""), std::string::npos) << text;
+    CommandResult heat = run(kEval + " image --ref " + tmp("png_ref.exr") + " --test-png " + tmp("png_test.png") +
+                             " --heatmap " + tmp("png_heat.png"));
+    EXPECT_EQ(heat.code, 2) << heat.out;
+    EXPECT_NE(heat.out.find("--heatmap and --flip-map need --test"), std::string::npos) << heat.out;
+    CommandResult both = run(kEval + " image --ref " + tmp("png_ref.exr") + " --test " + tmp("png_ref.exr") +
+                             " --test-png " + tmp("png_test.png"));
+    EXPECT_EQ(both.code, 2) << both.out;
+    CommandResult none = run(kEval + " image --ref " + tmp("png_ref.exr"));
+    EXPECT_EQ(none.code, 2) << none.out;
 }
 
 }  // namespace

@@ -131,6 +131,9 @@ std::vector<DrawCorner> drawCorners(const SurfaceLayout& layout);
 // every triangle's regular barycentric subdivision at rate r, three sample indices per small
 // triangle; both halves of a grid cell keep the triangle's winding (corner 0 -> 1 -> 2).
 std::vector<uint32_t> refinedTriangles(const SurfaceLayout& layout);
+// The diagonal of the samples' bounding box (object units, at least 1e-6): the unit of jitter
+// shading's cell, for the runtime and the glTF export alike.
+float samplesDiagonal(const SurfaceLayout& layout);
 // The points drawCorners' ids name (joining: the samples; charts: the chart vertices), for data
 // given per drawn vertex, such as Wyman's d_N.
 void drawPoints(const SurfaceLayout& layout, std::vector<glm::vec3>* positions,

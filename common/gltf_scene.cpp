@@ -1,4 +1,5 @@
 #include "common/gltf_scene.h"
+#include "common/gltf_model.h"
 
 #include <tiny_gltf.h>
 
@@ -36,6 +37,14 @@ std::string lowercaseExtension(const std::string& path) {
 // Images are never decoded: the bake reads geometry and media only.
 bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int,
                const unsigned char*, int, void*) {
+    return true;
+}
+
+// Images kept as the file holds them, never decoded (shrefract-export --into writes them back).
+bool keepEncodedImage(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
+                      const unsigned char* bytes, int size, void*) {
+    image->image.assign(bytes, bytes + size);
+    image->as_is = true;
     return true;
 }
 
@@ -521,15 +530,14 @@ bool isGltfPath(const std::string& path) {
     return ext == ".gltf" || ext == ".glb";
 }
 
-Scene loadGltfScene(const std::string& path, std::vector<GltfPlace>* places) {
+void readGltfModel(const std::string& path, tinygltf::Model& model, bool keepImages) {
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) throw inputError(path, "file not found");
     if (fs::file_size(path, ec) == 0) throw inputError(path, "file is empty");
     tinygltf::TinyGLTF loader;
-    loader.SetImageLoader(skipImage, nullptr);
+    loader.SetImageLoader(keepImages ? keepEncodedImage : skipImage, nullptr);
     loader.SetFsCallbacks({&regularFileExists, &tinygltf::ExpandFilePath, &readRegularFile,
                            &tinygltf::WriteWholeFile, nullptr});
-    tinygltf::Model model;
     std::string err, warn;
     const bool ok = lowercaseExtension(path) == ".glb"
                         ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
@@ -538,7 +546,16 @@ Scene loadGltfScene(const std::string& path, std::vector<GltfPlace>* places) {
         while (!err.empty() && std::isspace(static_cast<unsigned char>(err.back()))) err.pop_back();
         throw inputError(path, "could not read glTF: " + (err.empty() ? std::string("unknown error") : err));
     }
+}
+
+Scene gltfSceneOf(const std::string& path, const tinygltf::Model& model, std::vector<GltfPlace>* places) {
     return GltfReader(path, model).read(places);
+}
+
+Scene loadGltfScene(const std::string& path, std::vector<GltfPlace>* places) {
+    tinygltf::Model model;
+    readGltfModel(path, model, false);
+    return gltfSceneOf(path, model, places);
 }
 
 }  // namespace shrefract

@@ -1,6 +1,8 @@
 // Addressing in the surface layouts (declared in common/bakefile.h). The layouts themselves are
 // built by the bake (bake/joining_layout.cpp, bake/chart_layout.cpp); these are the lookups
 // everyone shares.
+#include <algorithm>
+
 #include "common/bakefile.h"
 #include "common/error.h"
 
@@ -72,6 +74,13 @@ std::vector<uint32_t> refinedTriangles(const SurfaceLayout& L) {
                                                    L.sampleAt(t, i, j + 1)});
             }
     return indices;
+}
+
+float samplesDiagonal(const SurfaceLayout& L) {
+    if (L.position.empty()) return 1e-6f;
+    glm::vec3 lo(L.position[0]), hi(L.position[0]);
+    for (const glm::vec3& p : L.position) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    return std::max(glm::length(hi - lo), 1e-6f);
 }
 
 }  // namespace shrefract

@@ -1,8 +1,6 @@
 // The glTF export (docs/format.md "glTF export: SHREFRACT_sh_refraction"), through tinygltf.
 #include "common/gltf/gltf_export.h"
 
-#include <tiny_gltf.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -14,7 +12,7 @@
 
 #include "common/error.h"
 #include "common/format_internal.h"
-#include "common/gltf_scene.h"
+#include "common/gltf_model.h"
 #include "common/png.h"
 #include "common/prefilter.h"
 #include "common/sh.h"
@@ -115,10 +113,12 @@ void checkExportable(const SurfaceLayout& L) {
                          " samples: more than a float32 sample number (_SHREFRACT_SAMPLE) holds");
 }
 
-// The sample grid's triangles over the samples `part` selects (all: -1) as a primitive: each
+// The sample grid's triangles `all` (refinedTriangles) over the samples `part` selects (all: -1)
+// as a primitive: each
 // vertex a sample, named in _SHREFRACT_SAMPLE, its position and normal taken from the bake's space
 // to the primitive's by `localFromBake` (normals by its inverse transpose).
-tinygltf::Primitive samplePrimitive(BinaryBuffer& bin, const SurfaceLayout& L, int part,
+tinygltf::Primitive samplePrimitive(BinaryBuffer& bin, const SurfaceLayout& L,
+                                    const std::vector<uint32_t>& all, int part,
                                     const glm::dmat4& localFromBake) {
     const size_t N = static_cast<size_t>(L.sampleCount());
     std::vector<uint32_t> vertexOf(N, UINT32_MAX);
@@ -143,7 +143,6 @@ tinygltf::Primitive samplePrimitive(BinaryBuffer& bin, const SurfaceLayout& L, i
     // A mirroring transform turns the winding over: turn it back.
     const bool mirrored = glm::determinant(glm::dmat3(localFromBake)) < 0.0;
     std::vector<uint32_t> indices;
-    const std::vector<uint32_t> all = refinedTriangles(L);
     for (size_t t = 0; t < all.size(); t += 3) {
         if (vertexOf[all[t]] == UINT32_MAX) continue;  // another part's
         indices.insert(indices.end(), {vertexOf[all[t]], vertexOf[all[t + (mirrored ? 2 : 1)]],
@@ -183,8 +182,6 @@ nlohmann::json addRefraction(tinygltf::Model& model, BinaryBuffer& bin, const Ba
     const SurfaceLayout& L = d.layout;
     checkExportable(L);
     const size_t N = static_cast<size_t>(L.sampleCount());
-    glm::vec3 blo(INFINITY), bhi(-INFINITY);
-    for (size_t i = 0; i < N; ++i) blo = glm::min(blo, L.position[i]), bhi = glm::max(bhi, L.position[i]);
     const float ior = frontIor(d);
     const glm::vec3 kappa = frontAbsorption(d);
 
@@ -224,7 +221,7 @@ nlohmann::json addRefraction(tinygltf::Model& model, BinaryBuffer& bin, const Ba
         {"offset", atlas.offset},
         {"ior", ior},
         {"absorption", {kappa.x, kappa.y, kappa.z}},
-        {"boundsDiagonal", std::max(glm::length(bhi - blo), 1e-6f)},  // as the runtime's Refractor
+        {"boundsDiagonal", samplesDiagonal(L)},  // as the runtime's Refractor
     };
     if (d.manifest.contains("branch") && d.manifest["branch"].is_string())
         r["branch"] = d.manifest["branch"];
@@ -336,7 +333,7 @@ std::vector<uint8_t> exportGlb(const GltfExport& what) {
     if (what.bake) {
         root["refractions"] = {addRefraction(model, bin, *what.bake, what.name)};
         // One node, one mesh: the whole sample grid, vertex v sample v, with a plain glass material.
-        tinygltf::Primitive prim = samplePrimitive(bin, what.bake->layout, -1, glm::dmat4(1.0));
+        tinygltf::Primitive prim = samplePrimitive(bin, what.bake->layout, refinedTriangles(what.bake->layout), -1, glm::dmat4(1.0));
         prim.material = glassMaterial(model, frontIor(*what.bake), frontAbsorption(*what.bake), used);
         tinygltf::Mesh mesh;
         mesh.name = what.name;
@@ -364,14 +361,6 @@ std::vector<uint8_t> exportGlb(const GltfExport& what) {
 }
 
 namespace {
-
-// An image's encoded bytes as the file holds them (no decoding: they are written back as they are).
-bool keepEncoded(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
-                 const unsigned char* bytes, int size, void*) {
-    image->image.assign(bytes, bytes + size);
-    image->as_is = true;
-    return true;
-}
 
 std::string sniffMime(const std::vector<unsigned char>& b, const std::string& uri) {
     if (b.size() >= 8 && b[0] == 0x89 && b[1] == 'P' && b[2] == 'N' && b[3] == 'G') return "image/png";
@@ -414,8 +403,10 @@ std::vector<uint8_t> exportInto(const BakeData& bake, const std::string& scenePa
                                 const std::vector<GltfEnvironment>& environments) {
     checkExportable(bake.layout);
     // The parts as the bake read them, and where each came from.
+    tinygltf::Model model;
+    readGltfModel(scenePath, model, true);
     std::vector<GltfPlace> places;
-    const Scene scene = loadGltfScene(scenePath, &places);
+    const Scene scene = gltfSceneOf(scenePath, model, &places);
     const nlohmann::json& media = bake.manifest.contains("media") ? bake.manifest["media"] : nlohmann::json();
     if (!media.is_array() || media.size() != scene.parts.size())
         throw InputError("the bake has " + std::to_string(media.is_array() ? media.size() : 0) +
@@ -426,15 +417,6 @@ std::vector<uint8_t> exportInto(const BakeData& bake, const std::string& scenePa
             throw InputError("glass part '" + scene.parts[p].name + "' of " + scenePath +
                              " is not the mesh the bake traced (its checksum differs): re-bake it");
 
-    tinygltf::Model model;
-    tinygltf::TinyGLTF loader;
-    loader.SetImageLoader(keepEncoded, nullptr);
-    std::string err, warn;
-    const bool glb = scenePath.size() >= 4 && (scenePath.compare(scenePath.size() - 4, 4, ".glb") == 0 ||
-                                               scenePath.compare(scenePath.size() - 4, 4, ".GLB") == 0);
-    if (!(glb ? loader.LoadBinaryFromFile(&model, &err, &warn, scenePath)
-              : loader.LoadASCIIFromFile(&model, &err, &warn, scenePath)))
-        throw InputError("could not read " + scenePath + ": " + err);
     gatherIntoOneBuffer(model);
     BinaryBuffer bin(model, false);
 
@@ -456,11 +438,12 @@ std::vector<uint8_t> exportInto(const BakeData& bake, const std::string& scenePa
             node.mesh = static_cast<int>(model.meshes.size()) - 1;
         }
     }
+    const std::vector<uint32_t> triangles = refinedTriangles(bake.layout);
     for (size_t p = 0; p < places.size(); ++p) {
         const GltfPlace& at = places[p];
         const int meshIndex = model.nodes.at(size_t(at.node)).mesh;
         tinygltf::Primitive& old = model.meshes.at(size_t(meshIndex)).primitives.at(size_t(at.primitive));
-        tinygltf::Primitive prim = samplePrimitive(bin, bake.layout, int(p), glm::inverse(at.world));
+        tinygltf::Primitive prim = samplePrimitive(bin, bake.layout, triangles, int(p), glm::inverse(at.world));
         prim.material = old.material;
         old = prim;
     }

@@ -90,9 +90,7 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
     m->settings.order = options.order < 0 ? m->maxOrder : std::min(options.order, m->maxOrder);
     m->settings.smoothing = options.smoothing;
     m->settings.correction = options.correction;
-    glm::vec3 lo(L.position[0]), hi(L.position[0]);
-    for (const glm::vec3& p : L.position) lo = glm::min(lo, p), hi = glm::max(hi, p);
-    m->diagonal = std::max(glm::length(hi - lo), 1e-6f);
+    m->diagonal = samplesDiagonal(L);
     GLint units = 16;
     glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &units);
     const PipelineInputs in{bake,        m->options,         m->settings, m->maxOrder,

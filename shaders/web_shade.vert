@@ -76,8 +76,14 @@ void main() {
     vec3 P = (uBakeFromLocal * vec4(position, 1.0)).xyz;
     vec3 N = normalize(uBakeNormal * normal);
     vec3 w = normalize(toLocalFrame(normalize(uEyeObject - P), N));
+    // The even functions are band-major, so one evaluation through the larger order serves both
+    // the weights (uOrder) and the error model (uErrorOrder).
     float y[SHREFRACT_SH_MAX_COUNT];
+#ifdef SHREFRACT_ERROR_MODEL
+    shEvalEven(max(uOrder, uErrorOrder), w, y);
+#else
     shEvalEven(uOrder, w, y);
+#endif
     int count = (uOrder + 1) * (uOrder + 2) / 2;
     vec4 d = vec4(0.0);
     for (int k = 0; k < SHREFRACT_SH_MAX_COUNT; ++k) {
@@ -85,7 +91,6 @@ void main() {
         d += (weightTexel(k, i) * uWeightScale[k] + uWeightOffset[k]) * y[k];
     }
 #ifdef SHREFRACT_ERROR_MODEL
-    shEvalEven(uErrorOrder, w, y);
     int errorCount = (uErrorOrder + 1) * (uErrorOrder + 2) / 2;
     float e = 0.0;
     ivec2 t = ivec2(i % uTileSize.x, i / uTileSize.x);

@@ -33,7 +33,9 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
     }
     const pages = r.pages.length;
     const useError = !!(errorModel && r.error);
-    const defines = { SHREFRACT_SH_MAX_ORDER: r.order, SHREFRACT_WEIGHT_PAGES: pages };
+    // Room for the SH through the weights' order and the error model's, whichever is larger.
+    const maxOrder = Math.max(r.order, useError ? r.error.order : 0);
+    const defines = { SHREFRACT_SH_MAX_ORDER: maxOrder, SHREFRACT_WEIGHT_PAGES: pages };
     if (useError) defines.SHREFRACT_ERROR_MODEL = '';
     const uniforms = {
       uBakeFromLocal: { value: new THREE.Matrix4() },

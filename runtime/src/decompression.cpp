@@ -95,7 +95,7 @@ Decompression::Decompression(const BakeData& d, const RefractorOptions& options,
             weightTex_.push_back(makeTexture2D(internal, muW_, muH_, GL_RGBA, type, data, GL_NEAREST));
     }
     if (d.errorOrder >= 0 && options.errorModel) {
-        errorFold_ = std::make_unique<ErrorFold>(d, texelOf);
+        errorFold_ = std::make_unique<ErrorFold>(d, texelOf, cover_.vertexShader());
         memory_.weights += errorFold_->bytes();
     }
     // Neighbour lists (CSR) for smoothing.

@@ -11,7 +11,8 @@ namespace shrefract {
 
 using namespace gl;
 
-ErrorFold::ErrorFold(const BakeData& bake, const std::vector<size_t>& texelOf)
+ErrorFold::ErrorFold(const BakeData& bake, const std::vector<size_t>& texelOf,
+                     const std::string& vertexShader)
     : width_(bake.layout.muWidth), height_(bake.layout.muHeight) {
     const int Ke = bake.errorCoefficientCount(), n = bake.layout.sampleCount();
     const size_t texels = size_t(width_) * height_;
@@ -31,7 +32,7 @@ ErrorFold::ErrorFold(const BakeData& bake, const std::vector<size_t>& texelOf)
     ShaderLimits limits = shaderPreset(ShaderPreset::Modern, 16);
     const DecompressionShaders sh = generateDecompression(bake.errorOrder, limits, ShForm::Polynomial);
     if (sh.passes.size() != 1) throw std::logic_error("shrefract: the error model needs one pass");
-    program_ = buildProgram(sh.vertex,
+    program_ = buildProgram(vertexShader,
                             shaders::withVersion(shaders::fill(shaders::source("error_fold.frag"),
                                                                "#pragma shrefract_generated",
                                                                sh.passes[0].generated),

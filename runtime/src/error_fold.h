@@ -5,6 +5,7 @@
 #pragma once
 
 #include <functional>
+#include <string>
 
 #include "common/bakefile.h"
 #include "gl.h"
@@ -14,8 +15,12 @@ namespace shrefract {
 class ErrorFold {
 public:
     // Uploads the bake's error model (BakeData::errors, errorOrder >= 0) as an R16F array, one
-    // layer per coefficient, and compiles the pass. `texelOf[i]`: sample i's mu texel.
-    ErrorFold(const BakeData& bake, const std::vector<size_t>& texelOf);
+    // layer per coefficient, and compiles the pass. `texelOf[i]`: sample i's mu texel. The pass
+    // links with `vertexShader`, the one its `draw` needs (the pipeline's, as the decompression
+    // passes do): a full-screen triangle drawn per chart triangle would shade the whole layout
+    // once for every triangle of the mesh.
+    ErrorFold(const BakeData& bake, const std::vector<size_t>& texelOf,
+              const std::string& vertexShader);
     ~ErrorFold();
     ErrorFold(const ErrorFold&) = delete;
     ErrorFold& operator=(const ErrorFold&) = delete;

@@ -13,6 +13,7 @@
 #include "common/decompress.h"
 #include "common/error.h"
 #include "common/sh.h"
+#include "gl.h"
 #include "shrefract/context.h"
 #include "shrefract/render.h"
 #include "shrefract/runtime.h"
@@ -196,6 +197,45 @@ TEST_P(ChartGl, RenderCoversTheObject) {
     direct.loader = context_->loader();
     direct.path = RefractorPath::Direct;
     EXPECT_THROW(Refractor::create(makeBake(data), direct), std::invalid_argument);
+}
+
+// The error model on a chart layout shades the charts' footprint once per frame, as the
+// decompression passes do: its pass must link with the unfolded mesh's vertex shader. With the
+// full-screen triangle's, the mesh's draw call covered the whole atlas again and again (measured:
+// 6 atlases a frame on the flat cube; on the bunny, 16 s a frame). Counted by an occlusion query
+// over one update, with and without the model.
+TEST_P(ChartGl, ErrorFoldShadesTheFootprintOnce) {
+    BakeData data = test::randomBake(chartLayout("scenes/flat_cube.obj", LayoutKind::Isolated, 2000, 2), 2);
+    const int n = data.layout.sampleCount();
+    data.errorOrder = 0;
+    data.errors.assign(size_t(n), std::log(0.05f + kErrorOffset) * std::sqrt(4.0f * float(M_PI)));
+    const Bake bake = makeBake(data);
+    auto fragments = [&](bool errorModel) {
+        RefractorOptions o;
+        o.loader = context_->loader();
+        o.errorModel = errorModel;
+        auto r = Refractor::create(bake, o);
+        r->update(FrameView::fromEye({0.4f, 0.9f, 2.7f}));  // compiles and warms up
+        GLuint query = 0;
+        gl::glGenQueries(1, &query);
+        gl::glBeginQuery(GL_SAMPLES_PASSED, query);
+        r->update(FrameView::fromEye({-0.8f, 0.5f, 2.5f}));
+        gl::glEndQuery(GL_SAMPLES_PASSED);
+        GLuint64 count = 0;
+        gl::glGetQueryObjectui64v(query, GL_QUERY_RESULT, &count);
+        gl::glDeleteQueries(1, &query);
+        return double(count);
+    };
+    const double plain = fragments(false), folded = fragments(true);
+    const double atlas = double(data.layout.muWidth) * data.layout.muHeight;
+    std::printf("[%s] update: %.0f fragments, %.0f with the error model; atlas %.0f texels, %d samples\n",
+                nameOf(GetParam()), plain, folded, atlas, n);
+    ASSERT_GT(plain, 0.0) << "the query counted nothing";
+    // Measured: the fold adds 2166 fragments, one per sample (each covered texel is a sample),
+    // against 19044 (6 atlases) with the full-screen vertex shader. Bounds: half the samples, and
+    // one atlas (1.5x the footprint here).
+    EXPECT_GT(folded - plain, 0.5 * n);
+    EXPECT_LE(folded - plain, atlas);
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, ChartGl, ::testing::Values(Backend::Egl, Backend::OSMesa),

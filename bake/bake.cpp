@@ -310,6 +310,7 @@ BakeData BakePlan::data(std::vector<float> weights, std::vector<float> errors,
     d.errorOrder = opt_.errorOrder < 0 ? -1 : opt_.errorOrder;
     d.errors = std::move(errors);
     d.manifest = manifest(stats);
+    quantizeWeights(d);  // what the file will hold, so the in-memory bake draws as it
     return d;
 }
 

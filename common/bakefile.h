@@ -176,6 +176,13 @@ struct ReadOptions {
     bool verify = true;
 };
 
+// The weights in memory as a file at `data.precision` holds them, so that a bake drawn straight
+// from memory draws as its file does: U8 rounds every weight to its code's value and sets
+// u8Scale and u8Offset (the fit writeBake makes, which gives the same again on the rounded
+// weights); F16 rounds to half; F32 leaves them. Throws std::invalid_argument on a non-finite
+// weight, as writeBake does.
+void quantizeWeights(BakeData& data);
+
 // Writes to a temporary file beside `path` and renames it when complete (writeAtomically,
 // common/output.h): on any failure nothing is left and an existing file at `path` is untouched;
 // a refused target (missing folder, symbolic link, FIFO, device) is an InputError, a failed

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <Imath/half.h>
+
 #include "common/format_internal.h"
 
 namespace shrefract::format_internal {
@@ -69,3 +71,23 @@ U8Params fitU8(const BakeData& d) {
 }
 
 }  // namespace shrefract::format_internal
+
+namespace shrefract {
+
+void quantizeWeights(BakeData& d) {
+    if (d.precision == Precision::F16) {
+        for (float& w : d.weights) w = float(Imath::half(w));
+    } else if (d.precision == Precision::U8) {
+        const format_internal::U8Params q = format_internal::fitU8(d);
+        const size_t N = d.layout.position.size();
+        for (size_t j = 0; j < d.weights.size(); ++j) {
+            const size_t kc = (j / (N * 4)) * 4 + j % 4;  // weights[(k * N + i) * 4 + c]
+            d.weights[j] = format_internal::dequantU8(
+                q.scale[kc], q.offset[kc], format_internal::quantU8(d.weights[j], q.scale[kc], q.offset[kc]));
+        }
+        d.u8Scale.assign(q.scale.begin(), q.scale.end());
+        d.u8Offset.assign(q.offset.begin(), q.offset.end());
+    }
+}
+
+}  // namespace shrefract

@@ -28,8 +28,8 @@ using Clock = std::chrono::steady_clock;
 int main(int argc, char** argv) {
     CLI::App app{"shrefract-bake: trace the refracted-path mapping of a glass object with Embree, "
                  "compress it onto spherical harmonics, write it as OpenEXR."};
-    std::string input, output, grid = "32x64", branch = "fresnel", precision = "f32";
     BakeOptions opt;
+    std::string input, output, grid = "32x64", branch = "fresnel", precision = nameOf(opt.precision);
     double ior = 1.5;
     int rate = 0;
     size_t samples = 35000;

@@ -105,7 +105,9 @@ int main(int argc, char** argv) {
         if (table1) {
             BakeResult res;
             if (bakePath.empty()) {
-                BakeOptions bo;  // the paper's settings: order 8, 32 x 64, 35k samples
+                BakeOptions bo;  // the paper's settings: order 8, f32, 32 x 64, 35k samples
+                bo.order = 8;
+                bo.precision = Precision::F32;
                 res = bake(scene, bo, mesh);
             } else {
                 res.data = readBake(bakePath);

@@ -328,6 +328,34 @@ TEST(Format, RoundTripU8WithinHalfAStep) {
     }
 }
 
+// quantizeWeights leaves in memory what the file holds: against the writer and reader (the round
+// trip above), bit for bit, at every precision; and once more changes nothing (the writer refits
+// the u8 scale on the rounded weights and must land on the same codes).
+TEST(Format, QuantizedWeightsAreWhatTheFileHolds) {
+    for (Precision p : {Precision::F32, Precision::F16, Precision::U8}) {
+        const fs::path path = scratch() / ("quantized_" + std::string(nameOf(p)) + ".shrefract.exr");
+        const BakeData d = syntheticBake(p);
+        BakeData q = d;
+        quantizeWeights(q);
+        writeBake(path.string(), d);
+        const BakeData r = readBake(path.string());
+        ASSERT_EQ(q.weights.size(), r.weights.size());
+        size_t moved = 0;
+        for (size_t v = 0; v < q.weights.size(); ++v) {
+            ASSERT_EQ(q.weights[v], r.weights[v]) << nameOf(p) << " weight " << v;
+            moved += q.weights[v] != d.weights[v];
+        }
+        EXPECT_EQ(moved > 0, p != Precision::F32) << nameOf(p) << ": " << moved << " weights rounded";
+        EXPECT_EQ(q.u8Scale, r.u8Scale) << nameOf(p);
+        EXPECT_EQ(q.u8Offset, r.u8Offset) << nameOf(p);
+        BakeData again = q;
+        quantizeWeights(again);
+        EXPECT_EQ(again.weights, q.weights) << nameOf(p);
+        writeBake(path.string(), q);
+        EXPECT_EQ(readBake(path.string()).weights, q.weights) << nameOf(p);
+    }
+}
+
 TEST(Format, U8ConstantChannelDecodesExactly) {
     const fs::path path = scratch() / "u8const.shrefract.exr";
     BakeData d = syntheticBake(Precision::U8);

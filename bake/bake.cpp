@@ -28,6 +28,10 @@ double secondsSince(Clock::time_point t0) {
 
 }  // namespace
 
+bool fitCanSolve(Fit fit, int L, const DirectionGrid& grid) {
+    return fit == Fit::Projection || shEvenCount(L) <= grid.count();
+}
+
 std::vector<int> evenBands(int L) {
     std::vector<int> bands;
     for (const ShLM& f : shEvenFunctions(L)) bands.push_back(f.l);
@@ -77,6 +81,11 @@ struct BakePlan::Compression {
 
 BakePlan::BakePlan(const Scene& scene, const BakeOptions& opt, const std::string& inputPath)
     : scene_(scene), opt_(opt), input_(inputPath) {
+    if (!fitCanSolve(opt.fit, opt.order, opt.grid))
+        throw InputError(str("--order ", opt.order, " stores ", shEvenCount(opt.order), " coefficients, more than the ",
+                             opt.grid.count(), " directions of --grid ", opt.grid.ToString(), ": the ",
+                             nameOf(opt.fit), " fit needs at least as many (a finer --grid, a lower "
+                             "--order, or --fit projection)"));
     const auto t0 = Clock::now();
     if (opt.layout == LayoutKind::Joining) {
         const int rate = opt.rate > 0 ? opt.rate : rateForSampleCount(scene, opt.samples);

@@ -150,6 +150,10 @@ struct BakeResult {
 // re-trace the same scene.
 BakeResult bake(const Scene& scene, const BakeOptions& options, const std::string& inputPath);
 
+// Whether `fit` can make order L from `grid`'s directions: the least-squares fits solve for the
+// coefficients from the directions, so they need at least as many; the projection does not.
+bool fitCanSolve(Fit fit, int L, const DirectionGrid& grid);
+
 // The stored functions' band l, for the filter: even order k -> l.
 std::vector<int> evenBands(int L);
 

@@ -5,24 +5,21 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <random>
+#include <set>
 
 #include <Eigen/Core>
 
+#include "bake/fit.h"
 #include "bake/joining_layout.h"
 #include "common/decompress.h"
+#include "common/error.h"
 #include "common/frame.h"
 #include "common/sh.h"
 
 namespace shrefract {
 namespace {
-
-struct HeldOut {
-    int triangle;
-    float u, v;         // barycentrics of corners 1, 2
-    glm::vec3 omega;    // object space, toward the viewer
-    glm::vec3 truth;    // exit direction of the fresh trace
-};
 
 // Triangle t of the scene in layout order (parts in order, their triangles in order).
 struct TriangleRef {
@@ -40,8 +37,81 @@ std::vector<TriangleRef> triangles(const Scene& s) {
 
 double angleDeg(glm::vec3 a, glm::vec3 b) {
     float la = glm::length(a);
-    if (la <= 0) return 180.0;
+    if (!(la > 0) || !std::isfinite(la)) return 180.0;  // no direction predicted: the worst
     return std::acos(std::clamp(double(glm::dot(a / la, b)), -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+// One sample's weights at order L from its J traced paths, as the bake fits them (bake.cpp):
+// the weighted fit per sample, or W = M R through the projection or least-squares matrix; the
+// band filter after.
+class OrderFit {
+public:
+    OrderFit(const BakeOptions& base, const DirectionGrid& grid, int L)
+        : K_(shEvenCount(L)), h_(shBandFilter(L, base.filterWidth)), band_(evenBands(L)) {
+        if (base.fit == Fit::Weighted) {
+            fitter_ = std::make_unique<WeightedFitter>(grid, L, base.weighting);
+        } else {
+            M_ = (base.fit == Fit::LeastSquares ? leastSquaresMatrix(grid, L)
+                                                : compressionMatrixCached(grid, L, base.cacheDir))
+                     .cast<float>();
+        }
+    }
+    int coefficients() const { return K_; }
+    // W (K x 4) from R (J x 4) and the paths (for the weighted fit's confidences).
+    void fit(const Eigen::MatrixXf& R, const std::vector<PathResult>& paths, Eigen::MatrixXf& W) const {
+        W.resize(K_, 4);
+        if (fitter_) {
+            std::vector<float> c(paths.size());
+            fitter_->confidence(paths.data(), c.data());
+            fitter_->fit(R, c.data(), W);
+        } else {
+            W.noalias() = M_ * R;
+        }
+        for (int k = 0; k < K_; ++k) W.row(k) *= float(h_[band_[k]]);
+    }
+
+private:
+    int K_;
+    std::vector<double> h_;
+    std::vector<int> band_;
+    std::unique_ptr<WeightedFitter> fitter_;
+    Eigen::MatrixXf M_;
+};
+
+TargetCandidate candidate(int order, int rate, const DirectionGrid& grid, Precision p, size_t samples) {
+    TargetCandidate c;
+    c.order = order, c.rate = rate, c.grid = grid, c.precision = p, c.samples = samples;
+    c.weightBytes = samples * weightsTexelBytes(shEvenCount(order), p);
+    c.bakeCost = double(samples) * grid.count();
+    return c;
+}
+
+bool isPaperModel(const TargetCandidate& c, int baseRate) {
+    return c.order == 8 && c.rate == baseRate && c.grid.nTheta == 32 && c.grid.nPhi == 64 &&
+           c.precision == Precision::F32;
+}
+
+std::string describe(const TargetCandidate& c) {
+    return str("order ", c.order, ", rate ", c.rate, ", ", nameOf(c.precision), ": ", c.weightBytes / 1e6, " MB");
+}
+
+// The angles (degrees, sorted) between each pair's truth and the prediction interpolated from
+// the triangle's samples; value(id, omega): sample id's decompressed value toward omega.
+template <class Value>
+std::vector<double> errorsDeg(const SurfaceLayout& L, const std::vector<HeldOutPair>& pairs, Value value) {
+    std::vector<glm::vec4> values(L.position.size());
+    std::vector<double> err;
+    err.reserve(pairs.size());
+    for (const HeldOutPair& h : pairs) {
+        for (int j = 0; j <= L.rate; ++j)
+            for (int i = 0; i + j <= L.rate; ++i) {
+                const uint32_t id = L.sampleAt(h.triangle, i, j);
+                values[id] = value(id, h.omega);
+            }
+        err.push_back(angleDeg(glm::vec3(interpolateRho(L, values.data(), h.triangle, h.u, h.v)), h.truth));
+    }
+    std::sort(err.begin(), err.end());
+    return err;
 }
 
 }  // namespace
@@ -49,8 +119,9 @@ double angleDeg(glm::vec3 a, glm::vec3 b) {
 nlohmann::json TargetSearchResult::ToJson() const {
     auto cj = [](const TargetCandidate& c) {
         return nlohmann::json{{"order", c.order}, {"rate", c.rate}, {"grid", c.grid.ToString()},
-                              {"medianDeg", c.medianDeg}, {"p95Deg", c.p95Deg}, {"meanDeg", c.meanDeg},
-                              {"samples", c.samples}, {"weightMB", c.weightBytes / 1e6}, {"paths", c.bakeCost}};
+                              {"precision", nameOf(c.precision)}, {"medianDeg", c.medianDeg},
+                              {"p95Deg", c.p95Deg}, {"meanDeg", c.meanDeg}, {"samples", c.samples},
+                              {"weightMB", c.weightBytes / 1e6}, {"paths", c.bakeCost}};
     };
     nlohmann::json a = nlohmann::json::array();
     for (const auto& c : all) a.push_back(cj(c));
@@ -59,13 +130,12 @@ nlohmann::json TargetSearchResult::ToJson() const {
             {"bakeSaving", reference.bakeCost / std::max(1.0, chosen.bakeCost)}};
 }
 
-TargetSearchResult searchTarget(const Scene& scene, const BakeOptions& base,
-                                const TargetSearchOptions& opt) {
+std::vector<HeldOutPair> heldOutPairs(const Scene& scene, const TraceOptions& trace,
+                                      const TargetSearchOptions& opt) {
+    // Area-weighted triangles, uniform barycentrics, uniform hemisphere directions about the
+    // interpolated normal.
     const std::vector<TriangleRef> tris = triangles(scene);
-    Tracer tracer(scene, base.trace);
-
-    // Held-out pairs: area-weighted triangles, uniform barycentrics, uniform hemisphere
-    // directions about the interpolated normal; truth traced once, shared by all candidates.
+    Tracer tracer(scene, trace);
     std::vector<double> area(tris.size());
     for (size_t t = 0; t < tris.size(); ++t) {
         const auto& P = tris[t].mesh->positions;
@@ -74,7 +144,7 @@ TargetSearchResult searchTarget(const Scene& scene, const BakeOptions& base,
     std::mt19937_64 rng(opt.seed);
     std::discrete_distribution<int> pickTriangle(area.begin(), area.end());
     std::uniform_real_distribution<float> U(0, 1);
-    std::vector<HeldOut> pairs;
+    std::vector<HeldOutPair> pairs;
     for (int k = 0; k < opt.points; ++k) {
         int t = pickTriangle(rng);
         float u = U(rng), v = U(rng);
@@ -92,90 +162,148 @@ TargetSearchResult searchTarget(const Scene& scene, const BakeOptions& base,
             pairs.push_back({t, u, v, omega, r.exit});
         }
     }
+    return pairs;
+}
 
-    const int Lmax = *std::max_element(opt.orders.begin(), opt.orders.end());
-    const int Kmax = shEvenCount(Lmax);
+std::vector<double> heldOutErrorsDeg(const BakeData& bake, const std::vector<HeldOutPair>& pairs) {
+    return errorsDeg(bake.layout, pairs, [&](uint32_t id, glm::vec3 omega) {
+        return decompressSample(bake, int(id), localViewDirection(bake.layout, int(id), omega));
+    });
+}
+
+TargetSearchResult searchTarget(const Scene& scene, const BakeOptions& base,
+                                const TargetSearchOptions& opt) {
+    const bool budget = opt.goal == TargetGoal::Budget;
     std::vector<int> rates = opt.rates.empty() ? std::vector<int>{1, 2, 3} : opt.rates;
     const int baseRate = base.rate > 0 ? base.rate : rateForSampleCount(scene, base.samples);
     if (std::find(rates.begin(), rates.end(), baseRate) == rates.end()) rates.push_back(baseRate);
+    std::map<int, size_t> samplesAt;
+    for (int r : rates) samplesAt[r] = joiningSampleCount(scene, r);
 
+    // What gets fitted: in a budget search only what fits in it, and the paper's model (the
+    // comparison printed beside the choice).
+    auto fits = [&](const TargetCandidate& c) { return !budget || c.weightBytes <= opt.budgetBytes; };
+    auto wanted = [&](const TargetCandidate& c) {
+        return fitCanSolve(base.fit, c.order, c.grid) && (fits(c) || isPaperModel(c, baseRate));
+    };
+    if (budget) {
+        const TargetCandidate* cheapest = nullptr;
+        std::vector<TargetCandidate> each;
+        for (int r : rates)
+            for (int L : opt.orders)
+                for (Precision p : opt.precisions)
+                    for (const DirectionGrid& g : opt.grids)
+                        if (fitCanSolve(base.fit, L, g)) each.push_back(candidate(L, r, g, p, samplesAt[r]));
+        for (const TargetCandidate& c : each)
+            if (!cheapest || c.weightBytes < cheapest->weightBytes) cheapest = &c;
+        if (!cheapest || cheapest->weightBytes > opt.budgetBytes)
+            throw InputError(str("--budget ", opt.budgetBytes / 1e6, " MB: the smallest model searched (",
+                                 cheapest ? describe(*cheapest) : std::string("none"),
+                                 " of weights) does not fit; raise the budget"));
+    }
+
+    const std::vector<HeldOutPair> pairs = heldOutPairs(scene, base.trace, opt);
+    Tracer tracer(scene, base.trace);
     TargetSearchResult result;
     for (int r : rates) {
-        SurfaceLayout L = buildJoiningLayout(scene, r);
-        const size_t total = L.position.size();
-        // Only the samples the held-out triangles touch are traced.
-        std::map<uint32_t, int> local;
-        for (const HeldOut& h : pairs)
-            for (int j = 0; j <= r; ++j)
-                for (int i = 0; i + j <= r; ++i) local.emplace(L.sampleAt(h.triangle, i, j), 0);
-        std::vector<uint32_t> ids;
-        for (auto& [id, slot] : local) slot = int(ids.size()), ids.push_back(id);
-
+        std::unique_ptr<SurfaceLayout> layout;  // built when a grid of this rate is traced
         for (const DirectionGrid& grid : opt.grids) {
+            // The orders with some precision wanted at this (rate, grid).
+            std::vector<int> orders;
+            for (int L : opt.orders)
+                for (Precision p : opt.precisions)
+                    if (wanted(candidate(L, r, grid, p, samplesAt[r]))) {
+                        orders.push_back(L);
+                        break;
+                    }
+            if (orders.empty()) continue;
+            if (!layout) layout = std::make_unique<SurfaceLayout>(buildJoiningLayout(scene, r));
+            const SurfaceLayout& L = *layout;
+            // Only the samples the held-out triangles touch are traced: `local` numbers them.
+            std::map<uint32_t, int> local;
+            for (const HeldOutPair& h : pairs)
+                for (int j = 0; j <= r; ++j)
+                    for (int i = 0; i + j <= r; ++i) local.emplace(L.sampleAt(h.triangle, i, j), 0);
+            std::vector<uint32_t> ids;
+            for (auto& [id, slot] : local) slot = int(ids.size()), ids.push_back(id);
+
+            if (opt.log)
+                opt.log(str("rate ", r, ", grid ", grid.ToString(), ": tracing ", ids.size(), " of ",
+                            samplesAt[r], " samples, fitting ", orders.size(), " orders"));
+            std::vector<OrderFit> fitters;
+            for (int order : orders) fitters.emplace_back(base, grid, order);
+            // weights[o]: the traced samples' weights at orders[o], laid out as a bake's.
+            std::vector<std::vector<float>> weights(orders.size());
+            for (size_t o = 0; o < orders.size(); ++o)
+                weights[o].assign(size_t(fitters[o].coefficients()) * ids.size() * 4, 0.0f);
             const int J = grid.count();
-            Eigen::MatrixXf Mt = compressionMatrixCached(grid, Lmax, base.cacheDir).transpose().cast<float>();
-            std::vector<glm::vec3> dirs(J);
-            for (int j = 0; j < J; ++j) dirs[j] = glm::vec3(grid.direction(j));
-            // W for every traced sample at Lmax: (K x 4) per sample, same layout as a bake.
-            BakeData partial;
-            partial.order = Lmax;
-            partial.layout.position.resize(ids.size());
-            partial.layout.normal.resize(ids.size());
-            partial.weights.assign(size_t(Kmax) * ids.size() * 4, 0.0f);
             tbb::parallel_for(size_t(0), ids.size(), [&](size_t s) {
                 enableFlushToZero();
-                uint32_t i = ids[s];
-                partial.layout.position[s] = L.position[i];
-                partial.layout.normal[s] = L.normal[i];
-                Frame f = Frame::fromNormal(L.normal[i]);
-                Eigen::MatrixXf R(J, 4);
+                const uint32_t i = ids[s];
+                const Frame f = Frame::fromNormal(L.normal[i]);
+                Eigen::MatrixXf R(J, 4), W;
+                std::vector<PathResult> paths(J);
                 for (int j = 0; j < J; ++j) {
-                    PathResult p = tracer.trace(L.position[i], L.normal[i], f.fromLocal(dirs[j]), L.part[i]);
-                    R.row(j) << p.exit.x, p.exit.y, p.exit.z, p.length;
+                    paths[j] = tracer.trace(L.position[i], L.normal[i], f.fromLocal(glm::vec3(grid.direction(j))), L.part[i]);
+                    R.row(j) << paths[j].exit.x, paths[j].exit.y, paths[j].exit.z, paths[j].length;
                 }
-                Eigen::MatrixXf Wt = R.transpose() * Mt;  // 4 x K
-                for (int k = 0; k < Kmax; ++k)
-                    for (int c = 0; c < 4; ++c) partial.weights[(size_t(k) * ids.size() + s) * 4 + c] = Wt(c, k);
+                for (size_t o = 0; o < orders.size(); ++o) {
+                    fitters[o].fit(R, paths, W);
+                    for (int k = 0; k < W.rows(); ++k)
+                        for (int c = 0; c < 4; ++c) weights[o][(size_t(k) * ids.size() + s) * 4 + c] = W(k, c);
+                }
             });
-            for (int order : opt.orders) {
-                std::vector<double> err;
-                std::vector<glm::vec4> values(total);
-                for (const HeldOut& h : pairs) {
-                    for (int j = 0; j <= r; ++j)
-                        for (int i = 0; i + j <= r; ++i) {
-                            uint32_t id = L.sampleAt(h.triangle, i, j);
-                            int s = local[id];
-                            values[id] = decompressSample(partial, s, localViewDirection(partial.layout, s, h.omega), order);
-                        }
-                    glm::vec4 d = interpolateRho(L, values.data(), h.triangle, h.u, h.v);
-                    err.push_back(angleDeg(glm::vec3(d), h.truth));
+            // Each order at each wanted precision, measured on the pairs through a bake that
+            // holds the traced samples only (the others are never looked up).
+            for (size_t o = 0; o < orders.size(); ++o) {
+                for (Precision p : opt.precisions) {
+                    TargetCandidate c = candidate(orders[o], r, grid, p, samplesAt[r]);
+                    if (!wanted(c)) continue;
+                    BakeData partial;
+                    partial.order = orders[o];
+                    partial.precision = p;
+                    partial.layout.position.resize(ids.size());
+                    partial.layout.normal.resize(ids.size());
+                    for (size_t s = 0; s < ids.size(); ++s)
+                        partial.layout.position[s] = L.position[ids[s]], partial.layout.normal[s] = L.normal[ids[s]];
+                    partial.weights = weights[o];
+                    // A fit close to as many coefficients as directions can be singular where the
+                    // weighting leaves few directions: such a model predicts nothing (180 deg).
+                    const bool finite = std::all_of(partial.weights.begin(), partial.weights.end(),
+                                                    [](float w) { return std::isfinite(w); });
+                    if (finite) quantizeWeights(partial);
+                    const std::vector<double> err =
+                        finite ? errorsDeg(L, pairs, [&](uint32_t id, glm::vec3 omega) {
+                            const int s = local.at(id);
+                            return decompressSample(partial, s, localViewDirection(partial.layout, s, omega));
+                        })
+                               : std::vector<double>(pairs.size(), 180.0);
+                    c.medianDeg = err[err.size() / 2];
+                    c.p95Deg = err[size_t(0.95 * (err.size() - 1))];
+                    double sum = 0;
+                    for (double e : err) sum += e;
+                    c.meanDeg = sum / err.size();
+                    if (isPaperModel(c, baseRate)) result.reference = c;
+                    if (fits(c)) result.all.push_back(c);
                 }
-                std::sort(err.begin(), err.end());
-                TargetCandidate c;
-                c.order = order, c.rate = r, c.grid = grid, c.samples = total;
-                c.medianDeg = err[err.size() / 2];
-                c.p95Deg = err[size_t(0.95 * (err.size() - 1))];
-                double sum = 0;
-                for (double e : err) sum += e;
-                c.meanDeg = sum / err.size();
-                c.weightBytes = total * size_t(shEvenCount(order)) * 16;
-                c.bakeCost = double(total) * J;
-                result.all.push_back(c);
-                if (r == baseRate && order == 8 && grid.nTheta == 32 && grid.nPhi == 64) result.reference = c;
             }
         }
     }
-    // The cheapest in memory that meets the target (then the cheapest to bake); else the most
-    // accurate candidate.
+
+    auto cheaper = [](const TargetCandidate& a, const TargetCandidate& b) {
+        return a.weightBytes != b.weightBytes ? a.weightBytes < b.weightBytes : a.bakeCost < b.bakeCost;
+    };
     const TargetCandidate* best = nullptr;
     for (const auto& c : result.all) {
-        if (c.medianDeg > opt.targetDeg) continue;
-        if (!best || c.weightBytes < best->weightBytes ||
-            (c.weightBytes == best->weightBytes && c.bakeCost < best->bakeCost))
-            best = &c;
+        if (budget) {  // the most accurate within the budget, then the cheapest
+            if (!best || c.medianDeg < best->medianDeg || (c.medianDeg == best->medianDeg && cheaper(c, *best)))
+                best = &c;
+        } else if (c.medianDeg <= opt.targetDeg && (!best || cheaper(c, *best))) {
+            best = &c;  // the cheapest meeting the target
+        }
     }
     result.reached = best != nullptr;
-    if (!best)
+    if (!best)  // no candidate meets the target: the most accurate
         for (const auto& c : result.all)
             if (!best || c.medianDeg < best->medianDeg) best = &c;
     result.chosen = *best;

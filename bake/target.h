@@ -1,7 +1,9 @@
-// The least model a scene needs: the smallest (order, rate, grid) whose error on held-out
-// (point, direction) pairs meets a target (`shrefract-bake --target-error DEG`).
+// The least model a scene needs, or the best one a budget buys: a search over (order, rate,
+// grid, precision) by the median angular error on held-out (point, direction) pairs
+// (`shrefract-bake --target-error DEG` and `--budget MB`; docs/bake.md "Choosing the model").
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -14,34 +16,59 @@ namespace shrefract {
 struct TargetCandidate {
     int order = 8, rate = 1;
     DirectionGrid grid;
+    Precision precision = Precision::F32;
     double medianDeg = 0, p95Deg = 0, meanDeg = 0;
     size_t samples = 0;        // unique samples of the whole scene at this rate
-    size_t weightBytes = 0;    // samples x coefficients x 4 channels x 4 bytes (f32)
+    size_t weightBytes = 0;    // samples x weightsTexelBytes(coefficients, precision)
     double bakeCost = 0;       // samples x directions: paths to trace
 };
 
+// Error: the fewest weight bytes (then the fewest paths) whose median meets `targetDeg`.
+// Budget: the lowest median whose weights fit in `budgetBytes` (then the fewest bytes, paths).
+enum class TargetGoal { Error, Budget };
+
 struct TargetSearchOptions {
-    double targetDeg = 10.0;  // on the median angular error over held-out pairs
+    TargetGoal goal = TargetGoal::Error;
+    double targetDeg = 10.0;  // Error: on the median angular error over held-out pairs
+    size_t budgetBytes = 0;   // Budget: the weights' bytes (file and GPU alike)
     int points = 400;         // held-out surface points, area-weighted over all triangles
     int directionsPerPoint = 4;
     uint64_t seed = 12345;
-    std::vector<int> orders{1, 2, 3, 4, 5, 6, 7, 8, 10, 12};
-    std::vector<int> rates;   // empty: 1, 2, 3
+    std::vector<int> orders{1, 2, 3, 4, 5, 6, 7, 8, 10, 12, 14, 16};
+    std::vector<int> rates;   // empty: 1, 2, 3 and the base options' rate
     std::vector<DirectionGrid> grids{{8, 16}, {16, 32}, {32, 64}, {64, 128}};
+    std::vector<Precision> precisions{Precision::F32, Precision::F16, Precision::U8};
+    std::function<void(const std::string&)> log;  // a line per (rate, grid) traced; may be empty
 };
 
 struct TargetSearchResult {
-    TargetCandidate chosen;     // the cheapest meeting the target, else the most accurate
-    TargetCandidate reference;  // the paper's fixed model: order 8, `base` rate, 32 x 64
-    bool reached = false;
-    std::vector<TargetCandidate> all;
+    TargetCandidate chosen;     // by the goal; for Error, the most accurate when none meets it
+    TargetCandidate reference;  // the paper's fixed model: order 8, the base rate, 32 x 64, f32
+    bool reached = false;       // Error: a candidate met the target (Budget: always)
+    std::vector<TargetCandidate> all;  // every candidate fitted (Budget: those within it, and the reference)
     nlohmann::json ToJson() const;
 };
 
-// Held-out pairs are random points inside triangles (not samples) and random directions (not
-// grid directions), truth from fresh traces; predictions interpolate decompressed samples
-// across the triangle exactly as the runtime's rho lookup does. Lower orders are truncations
-// of one projection (M's rows do not depend on L), so each (rate, grid) is traced once.
+// A held-out pair: a point inside a triangle (not a sample) and a direction (not a grid one),
+// its truth from a fresh trace.
+struct HeldOutPair {
+    int triangle;       // in layout order: the parts in order, their triangles in order
+    float u, v;         // barycentrics of corners 1, 2
+    glm::vec3 omega;    // object space, toward the viewer
+    glm::vec3 truth;    // exit direction of the fresh trace
+};
+std::vector<HeldOutPair> heldOutPairs(const Scene& scene, const TraceOptions& trace,
+                                      const TargetSearchOptions& options);
+// The angles (degrees, sorted) between each pair's truth and what `bake` predicts there, its
+// samples interpolated across the triangle as the runtime's rho lookup does. A joining bake of
+// the same scene.
+std::vector<double> heldOutErrorsDeg(const BakeData& bake, const std::vector<HeldOutPair>& pairs);
+
+// Each candidate is fitted as the bake would fit it (the base options' fit, band filter and
+// weighting) and rounded to its precision (u8's scale and offset from the traced samples, not
+// the whole bake's); only the samples the held-out triangles touch are traced, once per (rate,
+// grid). A Budget search fits no candidate over the budget, and traces no (rate, grid) that has
+// none within it. Throws InputError when no candidate fits the budget, naming the cheapest.
 TargetSearchResult searchTarget(const Scene& scene, const BakeOptions& base,
                                 const TargetSearchOptions& options);
 

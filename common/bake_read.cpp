@@ -14,11 +14,6 @@ using namespace format_internal;
 
 const uint64_t kMaxErrorTexelValues = uint64_t(shEvenCount(limits::kMaxErrorOrder));
 
-// Bytes of one weights texel: 16 per coefficient in f32, 8 in f16, 4 in u8.
-uint64_t weightsTexelBytes(int K, Precision p) {
-    return uint64_t(K) * (p == Precision::U8 ? 4 : p == Precision::F16 ? 8 : 16);
-}
-
 // The unfolded mesh and the seam sources of a chart layout (sizes from the manifest's "layout").
 template <class Find>
 void readChartParts(Imf::MultiPartInputFile& file, Find find, const json& layout,
@@ -252,6 +247,10 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options, ui
 }
 
 }  // namespace
+
+uint64_t weightsTexelBytes(int K, Precision p) {
+    return uint64_t(K) * (p == Precision::U8 ? 4 : p == Precision::F16 ? 8 : 16);
+}
 
 BakeData readBake(const std::string& path, const ReadOptions& options) {
     return readFile(path, [&](Imf::MultiPartInputFile& file, uint64_t bytes) {

@@ -176,6 +176,10 @@ struct ReadOptions {
     bool verify = true;
 };
 
+// Bytes of one sample's weights, K coefficients of four channels: 16 per coefficient in f32, 8 in
+// f16, 4 in u8, in the file's weights part and in the runtime's weight textures alike.
+uint64_t weightsTexelBytes(int K, Precision p);
+
 // The weights in memory as a file at `data.precision` holds them, so that a bake drawn straight
 // from memory draws as its file does: U8 rounds every weight to its code's value and sets
 // u8Scale and u8Offset (the fit writeBake makes, which gives the same again on the rounded

@@ -90,7 +90,13 @@ int main(int argc, char** argv) {
                    "pick the smallest order, rate and grid whose median error on held-out "
                    "directions is at most DEG degrees (overrides --order, --rate, --grid)")
         ->check(CLI::Range(0.001, 180.0));
-    app.add_option("--target-report", targetReport, "write the --target-error search as JSON");
+    double budgetMB = 0;
+    app.add_option("--budget", budgetMB,
+                   "pick the order, rate, grid and precision with the lowest median error on "
+                   "held-out directions whose weights fit in MB megabytes (10^6 bytes; overrides "
+                   "--order, --rate, --grid; a given --precision limits the search to it)")
+        ->check(CLI::PositiveNumber)->excludes("--target-error");
+    app.add_option("--target-report", targetReport, "write the --target-error or --budget search as JSON");
     std::string shardText, workDir, tracer = "coherent";
     int checkpoints = 0;
     bool resume = false;
@@ -122,8 +128,10 @@ int main(int argc, char** argv) {
                 throw InputError("--rate is for --layout joining; chart layouts take --samples or --texels");
             if (opt.layout == LayoutKind::Joining && !texels.empty())
                 throw InputError("--texels is for --layout isolated or uv");
-            if (opt.layout != LayoutKind::Joining && targetError > 0)
-                throw InputError("--target-error searches joining layouts only");
+            const bool search = targetError > 0 || budgetMB > 0;
+            const char* searchFlag = targetError > 0 ? "--target-error" : "--budget";
+            if (opt.layout != LayoutKind::Joining && search)
+                throw InputError(str(searchFlag, " searches joining layouts only"));
             if (!texels.empty()) {
                 int w = 0, h = 0;
                 char x = 0, extra = 0;
@@ -144,9 +152,9 @@ int main(int argc, char** argv) {
             ShardSlice slice;
             if (!shardText.empty()) {
                 slice = parseShard(shardText, std::getenv("SLURM_ARRAY_TASK_ID"));
-                if (targetError > 0)
-                    throw InputError("--target-error cannot be combined with --shard: run the search "
-                                     "once, then shard with the --order, --rate and --grid it chose");
+                if (search)
+                    throw InputError(str(searchFlag, " cannot be combined with --shard: run the search once, "
+                                         "then shard with the --order, --rate, --grid and --precision it chose"));
             }
             if (workDir.empty()) workDir = output + ".work";
             // Every output checked and staged before the work: a bad path fails now, not after an
@@ -165,25 +173,38 @@ int main(int argc, char** argv) {
             for (const Part& p : scene.parts)
                 for (const std::string& w : p.report.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
 
-            if (targetError > 0) {
+            if (search) {
                 TargetSearchOptions topt;
+                topt.goal = targetError > 0 ? TargetGoal::Error : TargetGoal::Budget;
                 topt.targetDeg = targetError;
-                if (!quiet) std::fprintf(stderr, "target-error: searching order, rate and grid on held-out pairs...\n");
+                topt.budgetBytes = static_cast<size_t>(budgetMB * 1e6);
+                if (app.count("--precision") > 0) topt.precisions = {opt.precision};
+                if (!quiet) {
+                    std::fprintf(stderr, "%s: searching order, rate, grid and precision on held-out pairs...\n",
+                                 searchFlag);
+                    topt.log = [](const std::string& line) { std::fprintf(stderr, "  %s\n", line.c_str()); };
+                }
                 TargetSearchResult t = searchTarget(scene, opt, topt);
                 const TargetCandidate& c = t.chosen;
                 const TargetCandidate& p = t.reference;
-                std::printf("target-error %.3g deg: %s order %d, rate %d, grid %s: median %.2f deg, p95 %.1f deg\n",
-                            targetError, t.reached ? "chose" : "NOT REACHED; most accurate is", c.order, c.rate,
-                            c.grid.ToString().c_str(), c.medianDeg, c.p95Deg);
-                std::printf("  paper's fixed model (order 8, rate %d, grid 32x64): median %.2f deg, %.1f MB of "
+                if (targetError > 0)
+                    std::printf("target-error %.3g deg: %s", targetError, t.reached ? "chose" : "NOT REACHED; most accurate is");
+                else
+                    std::printf("budget %.3g MB: chose", budgetMB);
+                std::printf(" order %d, rate %d, grid %s, %s: median %.2f deg, p95 %.1f deg, %.2f MB of weights\n",
+                            c.order, c.rate, c.grid.ToString().c_str(), nameOf(c.precision), c.medianDeg,
+                            c.p95Deg, c.weightBytes / 1e6);
+                std::printf("  paper's fixed model (order 8, rate %d, grid 32x64, f32): median %.2f deg, %.1f MB of "
                             "weights, %.3g paths\n", p.rate, p.medianDeg, p.weightBytes / 1e6, p.bakeCost);
-                std::printf("  chosen: %.1f MB of weights (%.2fx less), %.3g paths (%.2fx less)\n", c.weightBytes / 1e6,
-                            double(p.weightBytes) / std::max<size_t>(1, c.weightBytes), c.bakeCost,
+                std::printf("  chosen: %.2fx less memory, %.2fx less tracing\n",
+                            double(p.weightBytes) / std::max<size_t>(1, c.weightBytes),
                             p.bakeCost / std::max(1.0, c.bakeCost));
                 if (!targetReport.empty()) writeFile(stagedReport, t.ToJson().dump(2) + "\n");
                 opt.order = c.order;
                 opt.rate = c.rate;
                 opt.grid = c.grid;
+                opt.precision = c.precision;
+                precision = nameOf(c.precision);
             }
 
             const bool tty = cli::stderrIsTerminal();

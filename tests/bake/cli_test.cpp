@@ -87,7 +87,14 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"uvnone", "tetra.off", kTetra, "--layout uv", "has no texture coordinates"},
         BadCase{"uvflipped", "tetra.obj", kTetraUvFlipped, "--layout uv", "flipped in UV space"},
         BadCase{"uvoverlap", "tetra.obj", kTetraUvOverlap, "--layout uv", "overlap in UV space"},
-        BadCase{"uvoutside", "tetra.obj", kTetraUvOutside, "--layout uv", "outside [0, 1]"}),
+        BadCase{"uvoutside", "tetra.obj", kTetraUvOutside, "--layout uv", "outside [0, 1]"},
+        // The tetrahedron's smallest model: 4 samples at rate 1, order 1 (3 stored coefficients)
+        // in u8, 48 bytes; 0.00004 MB is 40.
+        BadCase{"budgetsmall", "tetra.off", kTetra, "--budget 0.00004", "order 1, rate 1, u8: 4.8e-05 MB"},
+        BadCase{"fitgrid", "tetra.off", kTetra, "--order 16 --grid 8x16", "--order 16 stores 153 coefficients, more than the 128 directions"},
+        BadCase{"budgettarget", "tetra.off", kTetra, "--budget 1 --target-error 5", "--target-error"},
+        BadCase{"budgetcharts", "tetra.off", kTetra, "--budget 1 --layout isolated", "--budget searches joining layouts only"},
+        BadCase{"budgetshard", "tetra.off", kTetra, "--budget 1 --shard 0/2", "--budget cannot be combined with --shard"}),
     [](const auto& info) { return std::string(info.param.name); });
 
 // The chart layouts bake the test objects and say what they made.

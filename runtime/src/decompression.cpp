@@ -94,7 +94,8 @@ Decompression::Decompression(const BakeData& d, const RefractorOptions& options,
         else
             weightTex_.push_back(makeTexture2D(internal, muW_, muH_, GL_RGBA, type, data, GL_NEAREST));
     }
-    if (d.errorOrder >= 0 && options.errorModel) {
+    // The fold feeds the lobe; sharp shading draws none, so it neither uploads nor runs it.
+    if (d.errorOrder >= 0 && options.errorModel && options.shading != Shading::Sharp) {
         errorFold_ = std::make_unique<ErrorFold>(d, texelOf, cover_.vertexShader());
         memory_.weights += errorFold_->bytes();
     }

@@ -319,6 +319,18 @@ BakeData BakePlan::data(std::vector<float> weights, std::vector<float> errors,
     d.errorOrder = opt_.errorOrder < 0 ? -1 : opt_.errorOrder;
     d.errors = std::move(errors);
     d.manifest = manifest(stats);
+    if (opt_.fit != Fit::Projection) {
+        // Near as many coefficients as directions, a least-squares solve can be singular once
+        // the weighting discounts the uncertain directions: say so, not that a weight is NaN.
+        const auto bad = std::find_if(d.weights.begin(), d.weights.end(), [](float w) { return !std::isfinite(w); });
+        if (bad != d.weights.end())
+            throw InputError(str("sample ", size_t(bad - d.weights.begin()) / 4 % d.layout.position.size(), ": the ",
+                                 nameOf(opt_.fit), " fit gave a non-finite weight at order ", opt_.order, " (",
+                                 shEvenCount(opt_.order), " coefficients from the ", opt_.grid.count(),
+                                 " directions of --grid ", opt_.grid.ToString(),
+                                 "): too few directions once it discounts the uncertain ones; use a finer "
+                                 "--grid or a lower --order"));
+    }
     quantizeWeights(d);  // what the file will hold, so the in-memory bake draws as it
     return d;
 }

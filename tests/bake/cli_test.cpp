@@ -92,6 +92,7 @@ INSTANTIATE_TEST_SUITE_P(
         // in u8, 48 bytes; 0.00004 MB is 40.
         BadCase{"budgetsmall", "tetra.off", kTetra, "--budget 0.00004", "order 1, rate 1, u8: 4.8e-05 MB"},
         BadCase{"fitgrid", "tetra.off", kTetra, "--order 16 --grid 8x16", "--order 16 stores 153 coefficients, more than the 128 directions"},
+        BadCase{"fitsingular", "tetra.off", kTetra, "--order 14 --grid 8x16", "the weighted fit gave a non-finite weight at order 14"},
         BadCase{"budgettarget", "tetra.off", kTetra, "--budget 1 --target-error 5", "--target-error"},
         BadCase{"budgetcharts", "tetra.off", kTetra, "--budget 1 --layout isolated", "--budget searches joining layouts only"},
         BadCase{"budgetshard", "tetra.off", kTetra, "--budget 1 --shard 0/2", "--budget cannot be combined with --shard"}),

@@ -7,7 +7,6 @@
 #include <map>
 #include <memory>
 #include <random>
-#include <set>
 
 #include <Eigen/Core>
 
@@ -255,18 +254,19 @@ TargetSearchResult searchTarget(const Scene& scene, const BakeOptions& base,
             });
             // Each order at each wanted precision, measured on the pairs through a bake that
             // holds the traced samples only (the others are never looked up).
+            BakeData partial;
+            partial.layout.position.resize(ids.size());
+            partial.layout.normal.resize(ids.size());
+            for (size_t s = 0; s < ids.size(); ++s)
+                partial.layout.position[s] = L.position[ids[s]], partial.layout.normal[s] = L.normal[ids[s]];
             for (size_t o = 0; o < orders.size(); ++o) {
                 for (Precision p : opt.precisions) {
                     TargetCandidate c = candidate(orders[o], r, grid, p, samplesAt[r]);
                     if (!wanted(c)) continue;
-                    BakeData partial;
                     partial.order = orders[o];
                     partial.precision = p;
-                    partial.layout.position.resize(ids.size());
-                    partial.layout.normal.resize(ids.size());
-                    for (size_t s = 0; s < ids.size(); ++s)
-                        partial.layout.position[s] = L.position[ids[s]], partial.layout.normal[s] = L.normal[ids[s]];
                     partial.weights = weights[o];
+                    partial.u8Scale.clear(), partial.u8Offset.clear();  // set again for u8 below
                     // A fit close to as many coefficients as directions can be singular where the
                     // weighting leaves few directions: such a model predicts nothing (180 deg).
                     const bool finite = std::all_of(partial.weights.begin(), partial.weights.end(),

@@ -204,7 +204,6 @@ int main(int argc, char** argv) {
                 opt.rate = c.rate;
                 opt.grid = c.grid;
                 opt.precision = c.precision;
-                precision = nameOf(c.precision);
             }
 
             const bool tty = cli::stderrIsTerminal();
@@ -335,7 +334,7 @@ int main(int argc, char** argv) {
                         pct(s.leaked));
             std::printf("  file        %.1f MB, order %d, %d coefficients, %s\n",
                         std::filesystem::file_size(output) / 1e6, opt.order, res.data.coefficientCount(),
-                        precision.c_str());
+                        nameOf(opt.precision));
             return int(cli::kOk);
         } catch (const Cancelled&) {
             if (!checkpointDir.empty())

@@ -81,6 +81,7 @@ struct BakePlan::Compression {
 
 BakePlan::BakePlan(const Scene& scene, const BakeOptions& opt, const std::string& inputPath)
     : scene_(scene), opt_(opt), input_(inputPath) {
+    opt_.errorOrder = storedErrorOrder(opt.errorOrder, opt.order, opt.grid);
     if (!fitCanSolve(opt.fit, opt.order, opt.grid))
         throw InputError(str("--order ", opt.order, " stores ", shEvenCount(opt.order), " coefficients, more than the ",
                              opt.grid.count(), " directions of --grid ", opt.grid.ToString(), ": the ",

@@ -12,6 +12,13 @@
 
 namespace shrefract {
 
+int storedErrorOrder(int requested, int order, const DirectionGrid& grid) {
+    if (requested < 0) return -1;
+    int e = std::min(requested, order);
+    while (e > 0 && shEvenCount(e) > grid.count()) --e;
+    return e;
+}
+
 ResidualFitter::ResidualFitter(const DirectionGrid& grid, int order, int errorOrder) {
     SHREFRACT_CHECK(errorOrder >= 0 && shEvenCount(errorOrder) <= grid.count());
     const int J = grid.count(), K = shEvenCount(order);

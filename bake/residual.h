@@ -12,11 +12,18 @@
 
 namespace shrefract {
 
-// The order of the error model a bake stores unless told otherwise: 15 numbers per sample beside
-// the 180 of order-8 weights (8 % more in f32), chosen by `shrefract-eval directions`' Spearman
-// correlation between predicted and measured error on bunny00: 0.59 at order 2, 0.70 at order 4
+// The order of the error model a bake stores unless told otherwise: 28 numbers per sample beside
+// the 91 of order-12 weights (one R16F layer each on the GPU, 15 % of the u8 weights' bytes),
+// chosen by `shrefract-eval directions`' Spearman correlation between predicted and measured
+// error on bunny00's default bake: 0.69 at order 4, 0.76 at order 6, 0.80 at order 8
 // (docs/bake.md "Error model").
-constexpr int kDefaultErrorOrder = 4;
+constexpr int kDefaultErrorOrder = 6;
+
+// The error model's order a bake with these settings stores: `requested` (< 0: none), but no
+// higher than the weights' `order` (the runtime's direct path and the web material evaluate both
+// from one SH evaluation through the larger) and with no more coefficients than the grid has
+// directions to fit them from.
+int storedErrorOrder(int requested, int order, const DirectionGrid& grid);
 
 // Build once per (grid, weight order, error order); use from many threads.
 class ResidualFitter {

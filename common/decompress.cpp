@@ -8,6 +8,7 @@
 
 #include "common/error.h"
 #include "common/frame.h"
+#include "common/limits.h"
 #include "common/prefilter.h"
 #include "common/sh.h"
 
@@ -41,8 +42,8 @@ glm::vec4 decompressSample(const BakeData& bake, int i, glm::vec3 wLocal, int or
 float predictedError(const BakeData& bake, int i, glm::vec3 wLocal) {
     if (bake.errorOrder < 0) return -1.0f;
     const int Ke = bake.errorCoefficientCount();
-    float basis[32];
-    SHREFRACT_CHECK(Ke <= 32);
+    float basis[shEvenCount(limits::kMaxErrorOrder)];
+    SHREFRACT_CHECK(Ke <= shEvenCount(limits::kMaxErrorOrder));
     shEvalEven(bake.errorOrder, glm::normalize(wLocal), basis);
     const size_t n = bake.layout.position.size();
     float e = 0.0f;

@@ -8,7 +8,7 @@ namespace shrefract::limits {
 constexpr double kMinIor = 1.0;  // below 1 is not a dielectric we trace
 constexpr double kMaxIor = 5.0;  // well past diamond (2.42) and rutile (2.9): likely a typo
 constexpr int kMaxOrder = 20;    // 231 coefficients: GL 3.3 guarantees 256 array layers
-constexpr int kMaxErrorOrder = 4;  // 15 coefficients: the runtime reads them as 4 RGBA texels
+constexpr int kMaxErrorOrder = 8;  // 45 coefficients: one R16F layer each in the runtime
 constexpr int kMaxRate = 64;     // grid steps per triangle edge (2145 samples per triangle)
 constexpr int kMaxBounces = 10000;
 constexpr double kMaxFilterWidth = 1000.0;  // bands

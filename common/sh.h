@@ -20,7 +20,7 @@ namespace shrefract {
 // (L+1)^2: all real SH through order L.
 inline int shCount(int L) { return (L + 1) * (L + 1); }
 // (L+1)(L+2)/2: the even-parity (l + m even) functions through order L.
-inline int shEvenCount(int L) { return (L + 1) * (L + 2) / 2; }
+constexpr int shEvenCount(int L) { return (L + 1) * (L + 2) / 2; }
 // Index of (l, m) among all functions: l^2 + l + m.
 inline int shIndex(int l, int m) { return l * l + l + m; }
 // Index of (l, m) among the even-parity functions (l + m even), in even order; -1 if l + m odd.

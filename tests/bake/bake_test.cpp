@@ -8,8 +8,10 @@
 #include <cstdio>
 
 #include <random>
+#include <tuple>
 
 #include "common/decompress.h"
+#include "common/sh.h"
 #include "test_meshes.h"
 
 namespace shrefract {
@@ -97,6 +99,27 @@ double lengthMae(Fit fit) {
         sum += std::abs(length - 2.0 * std::sqrt(1.0 - sinT * sinT));
     }
     return sum / n;
+}
+
+// A bake stores the error model it can: on a 2x4 grid (8 directions) an order-6 model's 28
+// coefficients cannot be fitted, and a bake at order 1 stores no model above its weights' order.
+// Each bake's model has storedErrorOrder's order and its coefficient count per sample, and every
+// value is finite (before the cap the first bake stopped on the fitter's CHECK).
+TEST(Bake, StoresTheErrorModelItsGridAndOrderAllow) {
+    const Scene scene = test::sceneOf(test::icosphere(1), 1.5);
+    BakeOptions o;
+    o.rate = 1;
+    o.threads = 1;
+    o.fit = Fit::Projection;
+    o.errorOrder = 6;
+    for (auto [order, grid, want] : {std::tuple{4, DirectionGrid{2, 4}, 2}, std::tuple{1, DirectionGrid{8, 16}, 1}}) {
+        o.order = order;
+        o.grid = grid;
+        const BakeData d = bake(scene, o, "<memory>").data;
+        EXPECT_EQ(d.errorOrder, want) << "order " << order << ", grid " << grid.ToString();
+        ASSERT_EQ(d.errors.size(), size_t(shEvenCount(want)) * d.layout.sampleCount());
+        EXPECT_TRUE(std::all_of(d.errors.begin(), d.errors.end(), [](float e) { return std::isfinite(e); }));
+    }
 }
 
 TEST(BakeLength, TransmitSphereMatchesTheChordLength) {

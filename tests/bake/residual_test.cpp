@@ -59,5 +59,17 @@ TEST(Residual, ConstantMissIsPredictedEverywhere) {
         for (int s = 0; s < 2; ++s) EXPECT_NEAR(predicted(E, s, w), s == 0 ? a0 : a1, 1e-4f) << "sample " << s;
 }
 
+// The stored order: the one asked for, capped by the weights' order and by the grid's directions
+// ((E+1)(E+2)/2 coefficients need at least as many). A 2x4 grid (8 directions) holds order 2 (6
+// coefficients) but not 3 (10); before the cap such a bake stopped on the fitter's CHECK.
+TEST(Residual, StoredOrderIsCappedByTheWeightsAndTheGrid) {
+    EXPECT_EQ(storedErrorOrder(kDefaultErrorOrder, 12, DirectionGrid{32, 64}), kDefaultErrorOrder);
+    EXPECT_EQ(storedErrorOrder(6, 4, DirectionGrid{32, 64}), 4);
+    EXPECT_EQ(storedErrorOrder(6, 8, DirectionGrid{2, 4}), 2);
+    EXPECT_EQ(storedErrorOrder(2, 8, DirectionGrid{2, 4}), 2);
+    EXPECT_EQ(storedErrorOrder(-1, 8, DirectionGrid{32, 64}), -1);
+    EXPECT_EQ(storedErrorOrder(6, 0, DirectionGrid{32, 64}), 0);
+}
+
 }  // namespace
 }  // namespace shrefract

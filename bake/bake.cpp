@@ -28,16 +28,6 @@ double secondsSince(Clock::time_point t0) {
 
 }  // namespace
 
-bool fitCanSolve(Fit fit, int L, const DirectionGrid& grid) {
-    return fit == Fit::Projection || shEvenCount(L) <= grid.count();
-}
-
-std::vector<int> evenBands(int L) {
-    std::vector<int> bands;
-    for (const ShLM& f : shEvenFunctions(L)) bands.push_back(f.l);
-    return bands;
-}
-
 BakeStats& BakeStats::operator+=(const BakeStats& o) {
     samples += o.samples, paths += o.paths, rays += o.rays;
     tir += o.tir, capped += o.capped, softCapped += o.softCapped, reentered += o.reentered;
@@ -64,17 +54,11 @@ BakeStats BakeStats::fromJson(const nlohmann::json& j) {
     return s;
 }
 
-// How a batch's R becomes its weights. Projection and least squares: W^T = R^T M^T, the matrix
-// in float for the GEMM with the band filter folded into its rows (filtering the weights equals
-// filtering M's rows: diag(h) (M R) = (diag(h) M) R), stored transposed: the GEMM then yields
-// W^T, whose column k (coefficient k of every sample in the batch, x y z len interleaved) is one
-// contiguous copy into the weights. The weighted fit solves per sample instead.
+// What the bake's workers share: how a batch's R becomes its weights (bake/fit.h SampleFit) and
+// its error model, and the grid directions in the order they are traced.
 struct BakePlan::Compression {
-    Eigen::MatrixXf Mt;
-    std::unique_ptr<WeightedFitter> fitter;  // Fit::Weighted only
+    std::unique_ptr<SampleFit> fit;
     std::unique_ptr<ResidualFitter> residual;  // the error model, when the bake stores one
-    std::vector<double> h;                   // band filter, per band
-    std::vector<int> band;                   // band of each stored coefficient
     std::vector<glm::vec3> dirs;             // grid directions, local frame
     std::vector<uint32_t> order;             // the order they are traced in: packetOrder(grid)
 };
@@ -104,20 +88,10 @@ BakePlan::~BakePlan() = default;
 
 void BakePlan::prepareTracing() const {
     std::call_once(prepared_, [&] {
-        const int K = shEvenCount(opt_.order);
         const int J = opt_.grid.count();
         auto c = std::make_unique<Compression>();
-        c->h = shBandFilter(opt_.order, opt_.filterWidth);
-        c->band = evenBands(opt_.order);
-        if (opt_.fit == Fit::Weighted) {
-            c->fitter = std::make_unique<WeightedFitter>(opt_.grid, opt_.order, opt_.weighting);
-        } else {
-            Eigen::MatrixXd Md = opt_.fit == Fit::LeastSquares
-                                     ? leastSquaresMatrix(opt_.grid, opt_.order)
-                                     : compressionMatrixCached(opt_.grid, opt_.order, opt_.cacheDir);
-            for (int k = 0; k < K; ++k) Md.row(k) *= c->h[c->band[k]];
-            c->Mt = Md.transpose().cast<float>();
-        }
+        c->fit = std::make_unique<SampleFit>(opt_.grid, opt_.order, opt_.fit, opt_.weighting,
+                                             opt_.filterWidth, opt_.cacheDir);
         if (opt_.errorOrder >= 0)
             c->residual = std::make_unique<ResidualFitter>(opt_.grid, opt_.order, opt_.errorOrder);
         c->dirs.resize(J);
@@ -139,10 +113,9 @@ SliceResult BakePlan::bakeSlice(size_t beginBatch, size_t endBatch, const SliceP
     const SurfaceLayout& L = layout_;
     const Tracer& tracer = *tracer_;
     const Compression& compression = *compression_;
-    const Eigen::MatrixXf& Mt = compression.Mt;
     const std::vector<glm::vec3>& dirs = compression.dirs;
     const std::vector<uint32_t>& order = compression.order;
-    const bool weighted = compression.fitter != nullptr;
+    const bool weighted = compression.fit->needsPaths();
     const size_t n = L.position.size();
     const int K = shEvenCount(opt.order);
     const int J = opt.grid.count();
@@ -165,11 +138,10 @@ SliceResult BakePlan::bakeSlice(size_t beginBatch, size_t endBatch, const SliceP
 
     tbb::parallel_for(tbb::blocked_range<size_t>(beginBatch, endBatch, 1), [&](const tbb::blocked_range<size_t>& range) {
         enableFlushToZero();
-        Eigen::MatrixXf R(J, 4 * kBakeBatch), Wt(4 * kBakeBatch, K), W(K, 4), E(Ke, kBakeBatch);
+        Eigen::MatrixXf R(J, 4 * kBakeBatch), Wt(4 * kBakeBatch, K), E(Ke, kBakeBatch);
         std::vector<glm::vec3> omegas(J);
         std::vector<PathResult> paths(J);
         std::vector<PathResult> batchPaths(weighted ? size_t(J) * kBakeBatch : 0);  // [s * J + j]
-        std::vector<float> confidence(weighted ? J : 0);
         for (size_t b = range.begin(); b != range.end(); ++b) {
             if (opt.cancel && opt.cancel->load()) return;
             const size_t batchFirst = b * kBakeBatch;
@@ -208,16 +180,7 @@ SliceResult BakePlan::bakeSlice(size_t beginBatch, size_t endBatch, const SliceP
             // 2. Compress the batch: the projection W = M R, one GEMM; or one weighted solve per
             // sample, the band filter applied to its weights.
             auto tGemm = Clock::now();
-            if (weighted) {
-                for (size_t s = 0; s < batchCount; ++s) {
-                    compression.fitter->confidence(&batchPaths[s * J], confidence.data());
-                    compression.fitter->fit(R.middleCols(4 * s, 4), confidence.data(), W);
-                    for (int k = 0; k < K; ++k) W.row(k) *= float(compression.h[compression.band[k]]);
-                    Wt.middleRows(4 * s, 4) = W.transpose();
-                }
-            } else {
-                Wt.noalias() = R.transpose() * Mt;
-            }
+            compression.fit->fit(R, weighted ? batchPaths.data() : nullptr, int(batchCount), Wt);
             // 3. Store its weights, and the error model of what they miss at the grid directions.
             for (int k = 0; k < K; ++k)
                 std::copy_n(Wt.col(k).data(), 4 * batchCount,

@@ -36,18 +36,6 @@ struct BakeProgress {
     double seconds = 0.0;
 };
 
-// How each sample's grid of traced paths becomes SH weights (docs/bake.md "Fits").
-enum class Fit {
-    Projection,    // W = M R through the compression matrix (paper eq. 10)
-    LeastSquares,  // solid-angle-weighted least squares on the grid samples
-    Weighted,      // least squares weighted by each path's confidence (bake/fit.h)
-};
-template <> struct EnumNames<Fit> {
-    static constexpr const char* what = "fit";
-    static constexpr NamedValue<Fit> table[] = {
-        {Fit::Projection, "projection"}, {Fit::LeastSquares, "lsq"}, {Fit::Weighted, "weighted"}};
-};
-
 struct BakeOptions {
     int order = 12;          // SH order L; 12 by the charts (docs/bake.md), the paper's is 8
     LayoutKind layout = LayoutKind::Joining;
@@ -149,12 +137,5 @@ struct BakeResult {
 // The whole bake in one slice. `inputPath` is recorded in the manifest so evaluation can
 // re-trace the same scene.
 BakeResult bake(const Scene& scene, const BakeOptions& options, const std::string& inputPath);
-
-// Whether `fit` can make order L from `grid`'s directions: the least-squares fits solve for the
-// coefficients from the directions, so they need at least as many; the projection does not.
-bool fitCanSolve(Fit fit, int L, const DirectionGrid& grid);
-
-// The stored functions' band l, for the filter: even order k -> l.
-std::vector<int> evenBands(int L);
 
 }  // namespace shrefract

@@ -3,12 +3,23 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <sstream>
 
 #include "common/error.h"
 #include "common/sh.h"
 
 namespace shrefract {
+
+bool fitCanSolve(Fit fit, int L, const DirectionGrid& grid) {
+    return fit == Fit::Projection || shEvenCount(L) <= grid.count();
+}
+
+std::vector<int> evenBands(int L) {
+    std::vector<int> bands;
+    for (const ShLM& f : shEvenFunctions(L)) bands.push_back(f.l);
+    return bands;
+}
 
 FitWeighting FitWeighting::none() {
     FitWeighting w;
@@ -125,6 +136,42 @@ void WeightedFitter::solve(const Eigen::Ref<const Eigen::MatrixXf>& R, const flo
     Eigen::VectorXf ac(J);
     for (int j = 0; j < J; ++j) ac(j) = a_(j) * c[j];
     W = G.selfadjointView<Eigen::Lower>().llt().solve(Y_.transpose() * (ac.asDiagonal() * R));
+}
+
+SampleFit::SampleFit(const DirectionGrid& grid, int order, Fit fit, const FitWeighting& weighting,
+                     double filterWidth, const std::string& cacheDir)
+    : K_(shEvenCount(order)) {
+    const std::vector<double> h = shBandFilter(order, filterWidth);
+    const std::vector<int> band = evenBands(order);
+    for (int k = 0; k < K_; ++k) h_.push_back(float(h[band[k]]));
+    if (fit == Fit::Weighted) {
+        fitter_ = std::make_unique<WeightedFitter>(grid, order, weighting);
+    } else {
+        Eigen::MatrixXd M = fit == Fit::LeastSquares ? leastSquaresMatrix(grid, order)
+                                                     : compressionMatrixCached(grid, order, cacheDir);
+        for (int k = 0; k < K_; ++k) M.row(k) *= h[band[k]];
+        Mt_ = M.transpose().cast<float>();
+    }
+}
+
+SampleFit::~SampleFit() = default;
+
+void SampleFit::fit(const Eigen::Ref<const Eigen::MatrixXf>& R, const PathResult* paths, int B,
+                    Eigen::Ref<Eigen::MatrixXf> Wt) const {
+    SHREFRACT_CHECK(R.cols() >= 4 * B && Wt.rows() >= 4 * B && Wt.cols() == K_);
+    if (!fitter_) {
+        Wt.topRows(4 * B).noalias() = R.leftCols(4 * B).transpose() * Mt_;
+        return;
+    }
+    const int J = fitter_->directions();
+    std::vector<float> confidence(J);
+    Eigen::MatrixXf W(K_, 4);
+    for (int s = 0; s < B; ++s) {
+        fitter_->confidence(paths + size_t(s) * J, confidence.data());
+        fitter_->fit(R.middleCols(4 * s, 4), confidence.data(), W);
+        for (int k = 0; k < K_; ++k) W.row(k) *= h_[k];
+        Wt.middleRows(4 * s, 4) = W.transpose();
+    }
 }
 
 }  // namespace shrefract

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -24,8 +25,28 @@
 
 #include "bake/tracer.h"
 #include "common/direction_grid.h"
+#include "shrefract/enum_names.h"
 
 namespace shrefract {
+
+// How each sample's grid of traced paths becomes SH weights (docs/bake.md "Fits").
+enum class Fit {
+    Projection,    // W = M R through the compression matrix (paper eq. 10)
+    LeastSquares,  // solid-angle-weighted least squares on the grid samples
+    Weighted,      // least squares weighted by each path's confidence (below)
+};
+template <> struct EnumNames<Fit> {
+    static constexpr const char* what = "fit";
+    static constexpr NamedValue<Fit> table[] = {
+        {Fit::Projection, "projection"}, {Fit::LeastSquares, "lsq"}, {Fit::Weighted, "weighted"}};
+};
+
+// Whether `fit` can make order L from `grid`'s directions: the least-squares fits solve for the
+// coefficients from the directions, so they need at least as many; the projection does not.
+bool fitCanSolve(Fit fit, int L, const DirectionGrid& grid);
+
+// The stored functions' band l, for the filter: even order k -> l.
+std::vector<int> evenBands(int L);
 
 struct FitWeighting {
     float flagged = 0.3f;  // c_j factor of a path with one of `flags`
@@ -67,6 +88,33 @@ private:
     Eigen::VectorXf a_;     // J: cell solid angles
     Eigen::MatrixXf Gall_;  // K x K: Y^T diag(a) Y, every direction at confidence 1
     Eigen::VectorXf ridge_; // K: ridge * l (l + 1)
+};
+
+// A bake's fit: traced exits to stored weights at one order, by `fit` (with `weighting` for the
+// weighted fit) and then the semi-Gaussian band filter of `filterWidth` bands (<= 0: none). The
+// bake (bake.cpp) and the --target-error / --budget search (target.cpp) both fit through it, so the
+// search scores exactly the weights the bake would store. Projection and least squares are one
+// GEMM per batch, W^T = R^T M^T, with the filter folded into M's rows (diag(h) (M R) =
+// (diag(h) M) R); the weighted fit solves per sample and filters its solution. Build once, use
+// from many threads.
+class SampleFit {
+public:
+    SampleFit(const DirectionGrid& grid, int order, Fit fit, const FitWeighting& weighting,
+              double filterWidth, const std::string& cacheDir);
+    ~SampleFit();
+    int coefficients() const { return K_; }
+    // Whether fit() reads the paths (the weighted fit's confidences); the others take nullptr.
+    bool needsPaths() const { return fitter_ != nullptr; }
+    // Wt (4B x K, sample s in rows 4s..4s+3: exit x, y, z, length) from R (J x 4B, sample s in
+    // columns 4s..4s+3) and, when needsPaths(), the B samples' paths (paths[s * J + j]).
+    void fit(const Eigen::Ref<const Eigen::MatrixXf>& R, const PathResult* paths, int B,
+             Eigen::Ref<Eigen::MatrixXf> Wt) const;
+
+private:
+    int K_;
+    std::vector<float> h_;                   // the filter of each stored coefficient
+    std::unique_ptr<WeightedFitter> fitter_;  // Fit::Weighted
+    Eigen::MatrixXf Mt_;                     // the others: M^T (J x K), filter folded in
 };
 
 }  // namespace shrefract

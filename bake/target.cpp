@@ -40,43 +40,6 @@ double angleDeg(glm::vec3 a, glm::vec3 b) {
     return std::acos(std::clamp(double(glm::dot(a / la, b)), -1.0, 1.0)) * 180.0 / M_PI;
 }
 
-// One sample's weights at order L from its J traced paths, as the bake fits them (bake.cpp):
-// the weighted fit per sample, or W = M R through the projection or least-squares matrix; the
-// band filter after.
-class OrderFit {
-public:
-    OrderFit(const BakeOptions& base, const DirectionGrid& grid, int L)
-        : K_(shEvenCount(L)), h_(shBandFilter(L, base.filterWidth)), band_(evenBands(L)) {
-        if (base.fit == Fit::Weighted) {
-            fitter_ = std::make_unique<WeightedFitter>(grid, L, base.weighting);
-        } else {
-            M_ = (base.fit == Fit::LeastSquares ? leastSquaresMatrix(grid, L)
-                                                : compressionMatrixCached(grid, L, base.cacheDir))
-                     .cast<float>();
-        }
-    }
-    int coefficients() const { return K_; }
-    // W (K x 4) from R (J x 4) and the paths (for the weighted fit's confidences).
-    void fit(const Eigen::MatrixXf& R, const std::vector<PathResult>& paths, Eigen::MatrixXf& W) const {
-        W.resize(K_, 4);
-        if (fitter_) {
-            std::vector<float> c(paths.size());
-            fitter_->confidence(paths.data(), c.data());
-            fitter_->fit(R, c.data(), W);
-        } else {
-            W.noalias() = M_ * R;
-        }
-        for (int k = 0; k < K_; ++k) W.row(k) *= float(h_[band_[k]]);
-    }
-
-private:
-    int K_;
-    std::vector<double> h_;
-    std::vector<int> band_;
-    std::unique_ptr<WeightedFitter> fitter_;
-    Eigen::MatrixXf M_;
-};
-
 TargetCandidate candidate(int order, int rate, const DirectionGrid& grid, Precision p, size_t samples) {
     TargetCandidate c;
     c.order = order, c.rate = rate, c.grid = grid, c.precision = p, c.samples = samples;
@@ -229,27 +192,31 @@ TargetSearchResult searchTarget(const Scene& scene, const BakeOptions& base,
             if (opt.log)
                 opt.log(str("rate ", r, ", grid ", grid.ToString(), ": tracing ", ids.size(), " of ",
                             samplesAt[r], " samples, fitting ", orders.size(), " orders"));
-            std::vector<OrderFit> fitters;
-            for (int order : orders) fitters.emplace_back(base, grid, order);
+            // Each order fitted as the bake fits it (bake/fit.h), one sample at a time.
+            std::vector<std::unique_ptr<SampleFit>> fitters;
+            for (int order : orders)
+                fitters.push_back(std::make_unique<SampleFit>(grid, order, base.fit, base.weighting,
+                                                              base.filterWidth, base.cacheDir));
             // weights[o]: the traced samples' weights at orders[o], laid out as a bake's.
             std::vector<std::vector<float>> weights(orders.size());
             for (size_t o = 0; o < orders.size(); ++o)
-                weights[o].assign(size_t(fitters[o].coefficients()) * ids.size() * 4, 0.0f);
+                weights[o].assign(size_t(fitters[o]->coefficients()) * ids.size() * 4, 0.0f);
             const int J = grid.count();
             tbb::parallel_for(size_t(0), ids.size(), [&](size_t s) {
                 enableFlushToZero();
                 const uint32_t i = ids[s];
                 const Frame f = Frame::fromNormal(L.normal[i]);
-                Eigen::MatrixXf R(J, 4), W;
+                Eigen::MatrixXf R(J, 4), Wt;
                 std::vector<PathResult> paths(J);
                 for (int j = 0; j < J; ++j) {
                     paths[j] = tracer.trace(L.position[i], L.normal[i], f.fromLocal(glm::vec3(grid.direction(j))), L.part[i]);
                     R.row(j) << paths[j].exit.x, paths[j].exit.y, paths[j].exit.z, paths[j].length;
                 }
                 for (size_t o = 0; o < orders.size(); ++o) {
-                    fitters[o].fit(R, paths, W);
-                    for (int k = 0; k < W.rows(); ++k)
-                        for (int c = 0; c < 4; ++c) weights[o][(size_t(k) * ids.size() + s) * 4 + c] = W(k, c);
+                    Wt.resize(4, fitters[o]->coefficients());
+                    fitters[o]->fit(R, paths.data(), 1, Wt);
+                    for (int k = 0; k < Wt.cols(); ++k)
+                        for (int c = 0; c < 4; ++c) weights[o][(size_t(k) * ids.size() + s) * 4 + c] = Wt(c, k);
                 }
             });
             // Each order at each wanted precision, measured on the pairs through a bake that

@@ -284,8 +284,8 @@ BakeData BakePlan::data(std::vector<float> weights, std::vector<float> errors,
     d.errors = std::move(errors);
     d.manifest = manifest(stats);
     if (opt_.fit != Fit::Projection) {
-        // Near as many coefficients as directions, a least-squares solve can be singular once
-        // the weighting discounts the uncertain directions: say so, not that a weight is NaN.
+        // The weighted fit solves even rank-deficient problems (bake/fit.cpp's double path); if
+        // a least-squares fit still comes out non-finite, say so, not that a weight is NaN.
         const auto bad = std::find_if(d.weights.begin(), d.weights.end(), [](float w) { return !std::isfinite(w); });
         if (bad != d.weights.end())
             throw InputError(str("sample ", size_t(bad - d.weights.begin()) / 4 % d.layout.position.size(), ": the ",

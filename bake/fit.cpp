@@ -1,6 +1,7 @@
 #include "bake/fit.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -135,7 +136,36 @@ void WeightedFitter::solve(const Eigen::Ref<const Eigen::MatrixXf>& R, const flo
     // B = Y^T diag(a c) R.
     Eigen::VectorXf ac(J);
     for (int j = 0; j < J; ++j) ac(j) = a_(j) * c[j];
-    W = G.selfadjointView<Eigen::Lower>().llt().solve(Y_.transpose() * (ac.asDiagonal() * R));
+    const Eigen::LLT<Eigen::MatrixXf, Eigen::Lower> llt(G.selfadjointView<Eigen::Lower>());
+    // cond(G) >= (max L_ii / min L_ii)^2: past 1e4, float's 6e-8 no longer gives the solution
+    // to 1e-3.
+    const Eigen::VectorXf pivots = llt.matrixLLT().diagonal();
+    if (llt.info() == Eigen::Success && pivots.minCoeff() > 1e-2f * pivots.maxCoeff()) {
+        W = llt.solve(Y_.transpose() * (ac.asDiagonal() * R));
+        if (W.allFinite()) return;
+    }
+    // The slow path, for the samples that need it. Close to as many coefficients as directions,
+    // the problem can be rank-deficient (order 14 on an 8x16 grid: cos 14 phi and cos 2 phi agree
+    // at 16 azimuths), and with most directions discounted the float update Gall -
+    // sum a (1 - c) y y^T cancels to a matrix that is badly conditioned or not positive definite
+    // (a tetrahedron there gave NaN). So: the same problem in double, from the weighted design
+    // matrix, rows sqrt(a_j c_j) y_j (never forming G, which squares the condition), plus rows
+    // sqrt(ridge_k) e_k; its minimum-norm solution by a complete orthogonal decomposition, which
+    // drops what the directions determine to less than 1e-6 of the best-determined part. Small
+    // coefficients, so the float weights keep what they sum to.
+    const int ridged = int((ridge_.array() > 0).count());
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(J + ridged, K), B = Eigen::MatrixXd::Zero(J + ridged, 4);
+    for (int j = 0; j < J; ++j) {
+        const double w = std::sqrt(double(ac(j)));
+        A.row(j) = w * Y_.row(j).cast<double>();
+        B.row(j) = w * R.row(j).cast<double>();
+    }
+    for (int k = 0, r = J; k < K; ++k)
+        if (ridge_(k) > 0) A(r++, k) = std::sqrt(double(ridge_(k)));
+    Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
+    cod.setThreshold(1e-6);
+    cod.compute(A);
+    W = cod.solve(B).cast<float>();
 }
 
 SampleFit::SampleFit(const DirectionGrid& grid, int order, Fit fit, const FitWeighting& weighting,

@@ -234,8 +234,8 @@ TargetSearchResult searchTarget(const Scene& scene, const BakeOptions& base,
                     partial.precision = p;
                     partial.weights = weights[o];
                     partial.u8Scale.clear(), partial.u8Offset.clear();  // set again for u8 below
-                    // A fit close to as many coefficients as directions can be singular where the
-                    // weighting leaves few directions: such a model predicts nothing (180 deg).
+                    // A fit that still came out non-finite (the bake would refuse it, BakePlan::data)
+                    // predicts nothing (180 deg).
                     const bool finite = std::all_of(partial.weights.begin(), partial.weights.end(),
                                                     [](float w) { return std::isfinite(w); });
                     if (finite) quantizeWeights(partial);

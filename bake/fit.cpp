@@ -102,11 +102,19 @@ void WeightedFitter::confidence(const PathResult* paths, float* c) const {
 void WeightedFitter::fit(const Eigen::Ref<const Eigen::MatrixXf>& R, const float* c,
                          Eigen::Ref<Eigen::MatrixXf> W) const {
     const int J = directions();
-    solve(R, c, W);
+    // G = Y^T diag(a c) Y = Gall - sum_j a_j (1 - c_j) y_j y_j^T: only the directions with c_j < 1
+    // cost a rank update (about half of them on a busy mesh, few on a simple one), and each trim
+    // pass only the directions it trims.
+    const std::vector<float> ones(J, 1.0f);
+    Eigen::MatrixXf G = Gall_;
+    G.diagonal() += ridge_;
+    lowerConfidence(G, ones.data(), c);
+    solve(G, R, c, W);
     const float cosTrim = std::cos(weighting_.trimDeg * float(M_PI) / 180.0f);
     std::vector<float> ct(c, c + J);
     for (int pass = 0; pass < weighting_.trimPasses; ++pass) {
         const Eigen::MatrixXf fitted = Y_ * W;  // J x 4
+        const std::vector<float> before = ct;
         bool changed = false;
         for (int j = 0; j < J; ++j) {
             const glm::vec3 f(fitted(j, 0), fitted(j, 1), fitted(j, 2)), r(R(j, 0), R(j, 1), R(j, 2));
@@ -116,23 +124,24 @@ void WeightedFitter::fit(const Eigen::Ref<const Eigen::MatrixXf>& R, const float
             if (miss && ct[j] == c[j]) ct[j] = c[j] * weighting_.trimmed, changed = true;
         }
         if (!changed) break;
-        solve(R, ct.data(), W);
+        lowerConfidence(G, before.data(), ct.data());
+        solve(G, R, ct.data(), W);
     }
 }
 
-void WeightedFitter::solve(const Eigen::Ref<const Eigen::MatrixXf>& R, const float* c,
-                           Eigen::Ref<Eigen::MatrixXf> W) const {
-    const int J = directions(), K = coefficients();
-    SHREFRACT_CHECK(R.rows() == J && R.cols() == 4 && W.rows() == K && W.cols() == 4);
-    // G = Y^T diag(a c) Y = Gall - sum_j a_j (1 - c_j) y_j y_j^T: only the directions with c_j < 1
-    // cost a rank update (about half of them on a busy mesh, few on a simple one).
-    Eigen::MatrixXf G = Gall_;
-    Eigen::MatrixXf down(K, J);
+void WeightedFitter::lowerConfidence(Eigen::MatrixXf& G, const float* from, const float* to) const {
+    const int J = directions();
+    Eigen::MatrixXf down(coefficients(), J);
     int nd = 0;
     for (int j = 0; j < J; ++j)
-        if (c[j] < 1.0f) down.col(nd++) = std::sqrt(a_(j) * (1.0f - c[j])) * Y_.row(j).transpose();
+        if (to[j] < from[j]) down.col(nd++) = std::sqrt(a_(j) * (from[j] - to[j])) * Y_.row(j).transpose();
     if (nd > 0) G.selfadjointView<Eigen::Lower>().rankUpdate(down.leftCols(nd), -1.0f);
-    G.diagonal() += ridge_;
+}
+
+void WeightedFitter::solve(const Eigen::MatrixXf& G, const Eigen::Ref<const Eigen::MatrixXf>& R,
+                           const float* c, Eigen::Ref<Eigen::MatrixXf> W) const {
+    const int J = directions(), K = coefficients();
+    SHREFRACT_CHECK(R.rows() == J && R.cols() == 4 && W.rows() == K && W.cols() == 4);
     // B = Y^T diag(a c) R.
     Eigen::VectorXf ac(J);
     for (int j = 0; j < J; ++j) ac(j) = a_(j) * c[j];

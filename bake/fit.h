@@ -53,15 +53,15 @@ struct FitWeighting {
     uint32_t flags = kPathTIR | kPathReentered | kPathCapped;
     float disagreeDeg = 30.0f;  // <= 0: no neighbour test
     float disagreeing = 0.01f;  // c_j at most this where the exit turns more than disagreeDeg
-    float trimDeg = 20.0f;      // a fitted direction this far off is trimmed...
+    float trimDeg = 10.0f;      // a fitted direction this far off is trimmed...
     float trimmed = 0.03f;      // ...c_j times this...
-    int trimPasses = 1;         // ...and the sample fitted again, this many times (0: none)
+    int trimPasses = 2;         // ...and the sample fitted again, this many times (0: none)
     float ridge = 0.0f;         // Tikhonov weight on band l: ridge * l (l + 1)
 
     // No weighting at all: the plain least-squares fit.
     static FitWeighting none();
     // "FLAGGED:DEG:DISAGREEING:TRIMDEG:TRIMMED:PASSES[:RIDGE]" (the
-    // defaults are "0.3:30:0.01:20:0.03:1"); throws InputError naming `what` on bad text.
+    // defaults are "0.3:30:0.01:10:0.03:2"); throws InputError naming `what` on bad text.
     static FitWeighting parse(const std::string& text, const std::string& what = "--fit-weighting");
     std::string ToString() const;
 };
@@ -80,7 +80,11 @@ public:
              Eigen::Ref<Eigen::MatrixXf> W) const;
 
 private:
-    void solve(const Eigen::Ref<const Eigen::MatrixXf>& R, const float* c,
+    // G -= sum_j a_j (from_j - to_j) y_j y_j^T over the directions whose confidence drops
+    // from `from` to `to` (G's lower triangle; the others cost nothing).
+    void lowerConfidence(Eigen::MatrixXf& G, const float* from, const float* to) const;
+    // W from G = Y^T diag(a c) Y + diag(ridge) (lower triangle), R and the same c.
+    void solve(const Eigen::MatrixXf& G, const Eigen::Ref<const Eigen::MatrixXf>& R, const float* c,
                Eigen::Ref<Eigen::MatrixXf> W) const;
     DirectionGrid grid_;
     FitWeighting weighting_;

@@ -196,7 +196,7 @@ TEST(WeightedFit, TrimPassRemovesAnOutlierNobodyFlagged) {
 
 TEST(WeightedFit, WeightingTextRoundTripsAndBadTextIsRefused) {
     const FitWeighting d;
-    EXPECT_EQ(d.ToString(), "0.3:30:0.01:20:0.03:1");
+    EXPECT_EQ(d.ToString(), "0.3:30:0.01:10:0.03:2");
     const FitWeighting p = FitWeighting::parse("0.5:15:0.02:10:0.1:2:0.001");
     EXPECT_FLOAT_EQ(p.flagged, 0.5f);
     EXPECT_FLOAT_EQ(p.disagreeDeg, 15.0f);

@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <random>
 
+#include <glm/glm.hpp>
+
 #include "common/error.h"
 #include "common/sh.h"
 
@@ -42,6 +44,44 @@ Known bandLimited(const DirectionGrid& g, int L, uint32_t seed) {
     return k;
 }
 
+// The weighted problem solved from its definition by SVD in double (no normal equations): rows
+// sqrt(a_j c_j) y_j, right side sqrt(a_j c_j) r_j, a_j the cell's solid angle by its own formula;
+// the minimum-norm solution, dropping what the grid cannot determine (below 1e-6).
+Eigen::MatrixXd weightedSolveSvd(const DirectionGrid& g, int L, const Eigen::MatrixXf& R,
+                                 const std::vector<float>& c) {
+    const int K = shEvenCount(L), J = g.count();
+    Eigen::MatrixXd A(J, K), B(J, 4);
+    std::vector<float> y(K);
+    const double dTheta = 0.5 * M_PI / g.nTheta, dPhi = 2.0 * M_PI / g.nPhi;
+    for (int j = 0; j < J; ++j) {
+        const int i = j / g.nPhi;
+        const double a = dPhi * (std::cos(i * dTheta) - std::cos((i + 1) * dTheta));
+        const double w = std::sqrt(a * c[j]);
+        shEvalEven(L, glm::vec3(g.direction(j)), y.data());
+        for (int q = 0; q < K; ++q) A(j, q) = w * y[q];
+        for (int q = 0; q < 4; ++q) B(j, q) = w * R(j, q);
+    }
+    Eigen::BDCSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    svd.setThreshold(1e-6);
+    return svd.solve(B);
+}
+
+// The largest difference at the grid directions between two sets of weights.
+double maxGridDifference(const DirectionGrid& g, int L, const Eigen::MatrixXd& W1,
+                         const Eigen::MatrixXd& W2) {
+    std::vector<float> y(shEvenCount(L));
+    double worst = 0;
+    for (int j = 0; j < g.count(); ++j) {
+        shEvalEven(L, glm::vec3(g.direction(j)), y.data());
+        for (int q = 0; q < 4; ++q) {
+            double d = 0;
+            for (size_t k = 0; k < y.size(); ++k) d += y[k] * (W1(k, q) - W2(k, q));
+            worst = std::max(worst, std::abs(d));
+        }
+    }
+    return worst;
+}
+
 // Every confidence 1, no trim: the plain least-squares fit, which common/ computes independently
 // in double precision as a matrix (leastSquaresMatrix).
 TEST(WeightedFit, WithoutWeightsItIsThePlainLeastSquaresFit) {
@@ -67,8 +107,7 @@ TEST(WeightedFit, WithoutWeightsItIsThePlainLeastSquaresFit) {
 // directions discounted 3000-fold, as on a tetrahedron whose paths are mostly TIR and trimmed:
 // the float rank update cancels to a matrix that is not positive definite, and before the double
 // fallback the solve gave NaN. The reference solves the same weighted problem from its
-// definition by SVD in double (no normal equations): rows sqrt(a_j c_j) y_j, right side
-// sqrt(a_j c_j) r_j.
+// definition (weightedSolveSvd).
 TEST(WeightedFit, NearlySingularWeightingStillSolvesTheWeightedProblem) {
     const DirectionGrid g{8, 16};
     const int L = 14, K = shEvenCount(L), J = g.count();
@@ -83,31 +122,10 @@ TEST(WeightedFit, NearlySingularWeightingStillSolvesTheWeightedProblem) {
     Eigen::MatrixXf W(K, 4);
     fitter.fit(k.R, c.data(), W);
     ASSERT_TRUE(W.allFinite());
-    Eigen::MatrixXd A(J, K), B(J, 4);
-    std::vector<float> y(K);
-    const double dTheta = 0.5 * M_PI / g.nTheta, dPhi = 2.0 * M_PI / g.nPhi;
-    for (int j = 0; j < J; ++j) {
-        const int i = j / g.nPhi;
-        const double a = dPhi * (std::cos(i * dTheta) - std::cos((i + 1) * dTheta));
-        const double w = std::sqrt(a * c[j]);
-        shEvalEven(L, glm::vec3(g.direction(j)), y.data());
-        for (int q = 0; q < K; ++q) A(j, q) = w * y[q];
-        for (int q = 0; q < 4; ++q) B(j, q) = w * k.R(j, q);
-    }
-    Eigen::BDCSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeThinU | Eigen::ComputeThinV);
-    svd.setThreshold(1e-6);  // the minimum-norm solution, dropping what the grid cannot determine
-    const Eigen::MatrixXd ref = svd.solve(B);
+    const Eigen::MatrixXd ref = weightedSolveSvd(g, L, k.R, c);
     // Compared where the fit is used, at the grid directions (the coefficients themselves are
     // ill-determined along the directions the weighting discounts).
-    double worst = 0;
-    for (int j = 0; j < J; ++j) {
-        shEvalEven(L, glm::vec3(g.direction(j)), y.data());
-        for (int q = 0; q < 4; ++q) {
-            double f = 0, r = 0;
-            for (int kk = 0; kk < K; ++kk) f += y[kk] * double(W(kk, q)), r += y[kk] * ref(kk, q);
-            worst = std::max(worst, std::abs(f - r));
-        }
-    }
+    const double worst = maxGridDifference(g, L, W.cast<double>(), ref);
     std::printf("[ measured ] max |fit - SVD| at the grid = %.3g\n", worst);
     // Measured 2.3e-5 (values of order 1); the bound leaves 8x. Without the double path the fit
     // is NaN; the normal equations in double miss by 8e9 (the squared condition), a basic
@@ -192,6 +210,65 @@ TEST(WeightedFit, TrimPassRemovesAnOutlierNobodyFlagged) {
     // Measured 0.124 untrimmed, 1.3e-4 trimmed; limits with a 10x margin.
     EXPECT_LT(e1, 1.3e-3f);
     EXPECT_GT(e0, 100 * e1);
+}
+
+// Trim passes update the normal matrix by the directions they trim, from confidences already
+// below 1. The slow path: each pass solved again from its definition (weightedSolveSvd, double)
+// at the confidences the same trim rule leaves. Exits turned 40 degrees are trimmed by the first
+// pass; those turned 14 degrees pull the first fit toward them and are missed by more than the
+// threshold only once the 40-degree ones are gone, so the second pass trims them.
+TEST(WeightedFit, TrimPassesSolveTheWeightedProblemAtTheirFinalConfidences) {
+    const DirectionGrid g{16, 32};
+    const int L = 6, K = shEvenCount(L), J = g.count();
+    Known k = bandLimited(g, L, 11);
+    auto turn = [&](int j, float deg) {  // r_j's exit turned by deg about an axis across it
+        const glm::vec3 v(k.R(j, 0), k.R(j, 1), k.R(j, 2));
+        const glm::vec3 axis = glm::normalize(glm::cross(v, glm::vec3(0.3f, -0.5f, 0.8f)));
+        const float a = glm::radians(deg);
+        const glm::vec3 t = v * std::cos(a) + glm::cross(axis, v) * std::sin(a);
+        for (int q = 0; q < 3; ++q) k.R(j, q) = t[q];
+    };
+    for (int j = 5; j < J; j += 23) turn(j, 40.0f);
+    for (int j = 9; j < J; j += 13) turn(j, 14.0f);
+    std::vector<float> c(J, 1.0f);
+    for (int j = 0; j < J; j += 3) c[j] = 0.3f;  // flagged: below 1 before any trim
+    FitWeighting w = FitWeighting::none();
+    w.trimDeg = 10.0f, w.trimmed = 0.03f, w.trimPasses = 3;
+    Eigen::MatrixXf W(K, 4);
+    WeightedFitter(g, L, w).fit(k.R, c.data(), W);
+
+    std::vector<float> ct = c;
+    Eigen::MatrixXd ref = weightedSolveSvd(g, L, k.R, ct);
+    std::vector<int> trims;
+    std::vector<float> y(K);
+    for (int pass = 0; pass < w.trimPasses; ++pass) {
+        int n = 0;
+        std::vector<float> next = ct;
+        for (int j = 0; j < J; ++j) {
+            shEvalEven(L, glm::vec3(g.direction(j)), y.data());
+            glm::dvec3 f(0.0);
+            for (int kk = 0; kk < K; ++kk)
+                f += double(y[kk]) * glm::dvec3(ref(kk, 0), ref(kk, 1), ref(kk, 2));
+            const glm::dvec3 r(k.R(j, 0), k.R(j, 1), k.R(j, 2));
+            const double deg = glm::degrees(std::acos(glm::clamp(
+                glm::dot(f, r) / (glm::length(f) * glm::length(r)), -1.0, 1.0)));
+            if (deg > w.trimDeg && ct[j] == c[j]) next[j] = c[j] * w.trimmed, ++n;
+        }
+        trims.push_back(n);
+        if (n == 0) break;
+        ct = next;
+        ref = weightedSolveSvd(g, L, k.R, ct);
+    }
+    std::printf("[ measured ] trimmed per pass:");
+    for (int n : trims) std::printf(" %d", n);
+    const double worst = maxGridDifference(g, L, W.cast<double>(), ref);
+    std::printf("; max |fit - SVD| at the grid = %.3g\n", worst);
+    ASSERT_GE(trims.size(), 2u);
+    EXPECT_GT(trims[1], 0) << "the second pass trims nothing: the case no longer tests it";
+    // Measured 1.4e-6 (values of order 1); the bound leaves 10x. Trims 52, 7 and 1 directions.
+    // Updating the normal matrix by 1 - c_j instead of by the drop from the previous pass misses
+    // by 0.093, skipping the update after the first fit by 0.33.
+    EXPECT_LT(worst, 1.5e-5);
 }
 
 TEST(WeightedFit, WeightingTextRoundTripsAndBadTextIsRefused) {

@@ -51,7 +51,8 @@ int main(int argc, char** argv) {
     std::vector<std::string> weightings = {"0.03:0:1:20:1:0",  "0.3:0:1:20:1:0",  "1:30:0.01:20:1:0",
                                            "1:0:1:20:0.03:1",  "0.3:30:0.01:20:1:0",
                                            "0.3:30:0.01:20:0.03:1", "0.3:30:0.01:20:0.03:2",
-                                           "0.3:30:0.01:10:0.03:1", "0.3:30:0.01:30:0.03:1"};
+                                           "0.3:30:0.01:10:0.03:1", "0.3:30:0.01:10:0.03:2",
+                                           "0.3:30:0.01:30:0.03:1"};
     app.add_option("mesh", mesh, "mesh or scene")->required();
     app.add_option("--weighting", weightings,
                    "weighted fits to study, FLAGGED:DEG:DISAGREEING:TRIMDEG:TRIMMED:PASSES each (bake/fit.h)")

@@ -149,12 +149,13 @@ void checkOff(const std::string& path, const std::string& text) {
                 throw inputError(path, where + " refers to vertex " + t[c] + " of " +
                                            std::to_string(nv));
         }
-        // An optional colour: 3 or 4 values after the indices.
-        const size_t extra = t.size() - 1 - k;
-        if ((extra != 0 && extra != 3 && extra != 4) ||
-            !std::all_of(t.begin() + 1 + long(k), t.end(), [&](const std::string& x) { return number(x, 65535); }))
-            throw inputError(path, where + " has " + std::to_string(extra) +
-                                       " values after its indices, not a colour");
+        // Nothing after the indices. OpenMesh's OFF reader does not read a face colour, even when
+        // asked to: it reads on through the stream, and takes the colour as the next face's
+        // vertex count (found by the fuzzer: a colour of -12 became a count of 2^32 - 12, and
+        // the reader grew a vector to 3 GB). A file with face colours is refused, not misread.
+        if (t.size() != k + 1)
+            throw inputError(path, where + " has " + std::to_string(t.size() - 1 - k) +
+                                       " values after its indices (face colours are not read)");
     }
 }
 
@@ -261,6 +262,13 @@ void checkPly(const std::string& path, const std::string& whole) {
     }
     if (format.empty()) throw inputError(path, "PLY header without a format line");
     if (!ended) throw inputError(path, "cut short: the PLY header has no end_header");
+    // Records without properties take no bytes in a binary file, so no file size bounds their
+    // count, and OpenMesh reserves memory for all of them (found by the fuzzer: 2^28 vertices
+    // without properties asked for 3 GB). They carry nothing, so they are refused in any format.
+    for (const PlyElement& e : elements)
+        if (e.count > 0 && e.properties.empty())
+            throw inputError(path, "PLY header: element " + e.name + " has " + std::to_string(e.count) +
+                                       " records but no properties");
     auto promise = [&](const PlyElement& e, uint64_t got) {
         return "cut short: the header promises " + std::to_string(e.count) + " " + e.name +
                " elements, the file ends after " + std::to_string(got);
@@ -302,7 +310,7 @@ void checkPly(const std::string& path, const std::string& whole) {
     const uint64_t end = text.size();
     uint64_t at = in.tellg() == std::streampos(-1) ? end : uint64_t(in.tellg());
     for (const PlyElement& e : elements) {
-        if (e.properties.empty()) continue;
+        if (e.properties.empty()) continue;  // and so no records
         uint64_t fixed = 0;
         bool lists = false;
         for (const PlyProperty& p : e.properties) {

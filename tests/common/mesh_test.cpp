@@ -314,6 +314,24 @@ TEST(Mesh, CutShortFilesAreRefused) {
     badCoordinate.replace(badCoordinate.find("end_header\n") + 11, 1, "inf");
     expectInputError(writeText("index.ply", badIndex), "'3HHH' is not an integer");
     expectInputError(writeText("coordinate.ply", badCoordinate), "is not a number");
+    // Records without properties take no bytes, so a binary file's size cannot bound their count
+    // (found by the fuzzer: OpenMesh reserved 3 GB for 2^28 of them). The cube with one more
+    // element of that kind, in either format, is refused.
+    const std::string empty = "element extra 268435456\nend_header\n";
+    std::string emptyBinary = ply, emptyAscii = asciiPly;
+    emptyBinary.replace(emptyBinary.find("end_header\n"), 11, empty);
+    emptyAscii.replace(emptyAscii.find("end_header\n"), 11, empty);
+    expectInputError(writeText("empty_records.ply", emptyBinary),
+                     "element extra has 268435456 records but no properties");
+    expectInputError(writeText("empty_records_ascii.ply", emptyAscii),
+                     "element extra has 268435456 records but no properties");
+    // A face colour: OpenMesh's OFF reader reads it as the next face's vertex count (found by
+    // the fuzzer: -12 became 2^32 - 12, and the reader grew a vector to 3 GB).
+    std::string colour = off;
+    size_t lineEnd = 0;
+    for (int line = 0; line < 11; ++line) lineEnd = colour.find('\n', lineEnd) + 1;
+    colour.insert(lineEnd - 1, " -12 7 6");  // after the first face's indices (line 11)
+    expectInputError(writeText("colour.off", colour), "line 11: face 0 has 3 values after its indices");
     expectInputError(writeText("short.obj", "v 0 0 0\nv 1 0 0\nv 0 1\n"),
                      "line 3: a vertex is not 3 numbers");
     expectInputError(writeText("corner.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 f 3\n"),

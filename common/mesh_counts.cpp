@@ -111,9 +111,16 @@ void checkOff(const std::string& path, const std::string& text) {
                                "counts must stand on the line after " + key);
     if (!lines.next(&line)) throw inputError(path, "cut short: OFF without its counts");
     t = tokens(line);
-    uint64_t nv = 0, nf = 0;
+    // Exactly the vertex, face and edge counts. OpenMesh reads the three from the stream, not
+    // from the line: with two it takes the first coordinate for the edge count and reads every
+    // vertex out of step (a cube loaded with bounds up to 3 and one face missing); with more it
+    // reads on past them, and the fuzzer's "8 04 63 2 3 3 -1 0" made a face of 2^31 vertices.
+    uint64_t nv = 0, nf = 0, ne = 0;
     if (t.size() < 2 || !isCount(t[0], &nv) || !isCount(t[1], &nf))
         throw inputError(path, "could not parse: no vertex and face counts after " + key);
+    if (t.size() != 3 || !isCount(t[2], &ne))
+        throw inputError(path, "line " + std::to_string(lines.number()) + ": the counts line holds " +
+                                   std::to_string(t.size()) + " values, not the vertex, face and edge counts");
     const std::string promise = "the header promises " + std::to_string(nv) + " vertices and " +
                                 std::to_string(nf) + " faces";
     // Every value as OpenMesh's stream reads it: a number it would overflow on (and then read no

@@ -9,8 +9,8 @@ namespace shrefract {
 
 // Throws InputError naming the file when it holds less (or, for a binary STL, other) than its
 // header promises:
-//   OFF   text: nv vertex lines of 3+ numbers, then nf face lines "k i1 .. ik" (k >= 3) and nothing
-//         more (no face colour);
+//   OFF   text: exactly "nv nf ne" on the counts line, nv vertex lines of 3+ numbers, then nf face
+//         lines "k i1 .. ik" (k >= 3) and nothing more (no face colour);
 //         binary: the bytes of nv vertices and nf faces;
 //   PLY   every element's count of lines (ascii) or of records (binary, lists walked);
 //   STL   binary: exactly 84 + 50 n bytes for its n triangles; ASCII: 3 vertices per facet,

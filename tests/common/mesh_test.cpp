@@ -332,6 +332,18 @@ TEST(Mesh, CutShortFilesAreRefused) {
     for (int line = 0; line < 11; ++line) lineEnd = colour.find('\n', lineEnd) + 1;
     colour.insert(lineEnd - 1, " -12 7 6");  // after the first face's indices (line 11)
     expectInputError(writeText("colour.off", colour), "line 11: face 0 has 3 values after its indices");
+    // The counts line holds exactly three counts. OpenMesh reads them from the stream: with two
+    // it took the first coordinate for the edge count and loaded a wrong cube; with more it reads
+    // on past them, out of step (found by the fuzzer: "8 04 63 2 3 3 -1 0" made a face of 2^31
+    // vertices). An edge count that is not a count is refused as well.
+    const size_t countsAt = off.find('\n') + 1, countsSize = off.find('\n', countsAt) - countsAt;
+    const std::pair<std::string, int> badCounts[] = {{"8 12", 2}, {"8 12 0 3 3 -1 0", 7}, {"8 12 -1", 3}};
+    for (const auto& [bad, values] : badCounts) {
+        SCOPED_TRACE(bad);
+        expectInputError(writeText("counts.off", std::string(off).replace(countsAt, countsSize, bad)),
+                         "line 2: the counts line holds " + std::to_string(values) +
+                             " values, not the vertex, face and edge counts");
+    }
     expectInputError(writeText("short.obj", "v 0 0 0\nv 1 0 0\nv 0 1\n"),
                      "line 3: a vertex is not 3 numbers");
     expectInputError(writeText("corner.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 f 3\n"),

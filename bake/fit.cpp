@@ -16,6 +16,14 @@ bool fitCanSolve(Fit fit, int L, const DirectionGrid& grid) {
     return fit == Fit::Projection || shEvenCount(L) <= grid.count();
 }
 
+glm::vec4 evaluateFit(int L, const Eigen::Ref<const Eigen::MatrixXf>& W, glm::vec3 w) {
+    std::vector<float> y(shEvenCount(L));
+    shEvalEven(L, w, y.data());
+    glm::vec4 e(0.0f);
+    for (int k = 0; k < W.rows(); ++k) e += y[k] * glm::vec4(W(k, 0), W(k, 1), W(k, 2), W(k, 3));
+    return e;
+}
+
 std::vector<int> evenBands(int L) {
     std::vector<int> bands;
     for (const ShLM& f : shEvenFunctions(L)) bands.push_back(f.l);

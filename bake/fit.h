@@ -94,6 +94,9 @@ private:
     Eigen::VectorXf ridge_; // K: ridge * l (l + 1)
 };
 
+// Weights W (shEvenCount(L) x 4) evaluated at the unit direction w: exit x, y, z, length.
+glm::vec4 evaluateFit(int L, const Eigen::Ref<const Eigen::MatrixXf>& W, glm::vec3 w);
+
 // A bake's fit: traced exits to stored weights at one order, by `fit` (with `weighting` for the
 // weighted fit) and then the semi-Gaussian band filter of `filterWidth` bands (<= 0: none). The
 // bake (bake.cpp) and the --target-error / --budget search (target.cpp) both fit through it, so the

@@ -40,15 +40,11 @@ SplitModel SplitFitter::fit(const Eigen::Ref<const Eigen::MatrixXf>& R, const Pa
 }
 
 glm::vec4 SplitFitter::evaluate(const SplitModel& m, glm::vec3 w) const {
-    std::vector<float> y(shEvenCount(std::max(branchOrder_, indicatorOrder_)));
+    std::vector<float> y(shEvenCount(indicatorOrder_));
     shEvalEven(indicatorOrder_, w, y.data());
     float inside = 0.0f;
     for (int k = 0; k < m.indicator.size(); ++k) inside += y[k] * m.indicator(k);
-    const Eigen::MatrixXf& W = m.branch[inside > 0.5f ? 1 : 0];
-    shEvalEven(branchOrder_, w, y.data());
-    glm::vec4 e(0.0f);
-    for (int k = 0; k < W.rows(); ++k) e += y[k] * glm::vec4(W(k, 0), W(k, 1), W(k, 2), W(k, 3));
-    return e;
+    return evaluateFit(branchOrder_, m.branch[inside > 0.5f ? 1 : 0], w);
 }
 
 }  // namespace shrefract

@@ -31,8 +31,6 @@ public:
     // no reason to doubt a path, so `weighting` drops those flags; the others still lower c_j.
     SplitFitter(const DirectionGrid& grid, int branchOrder, int indicatorOrder, uint32_t classFlags,
                 FitWeighting weighting = {});
-    int branchOrder() const { return branchOrder_; }
-    int indicatorOrder() const { return indicatorOrder_; }
     // Floats stored per sample: four channels per branch coefficient, one per indicator's.
     int floats() const;
     // The model of one sample from its J grid paths and R (J x 4: exit x, y, z, length).

@@ -168,13 +168,7 @@ int main(int argc, char** argv) {
                 }
                 SplitModel split;
                 if (splitter) split = splitter->fit(R, paths);
-                std::vector<float> basis(K);
-                auto whole = [&](glm::vec3 w) {
-                    shEvalEven(order, w, basis.data());
-                    glm::vec4 e(0.0f);
-                    for (int k = 0; k < K; ++k) e += basis[k] * glm::vec4(W(k, 0), W(k, 1), W(k, 2), W(k, 3));
-                    return e;
-                };
+                auto whole = [&](glm::vec3 w) { return evaluateFit(order, W, w); };
                 // Pick: the split only where it misses the grid's own exits by less, on the mean over
                 // the grid directions, than the whole-hemisphere fit at `order` (the bake's default
                 // weighting) does. The bake can do this: it knows the exits at the grid.

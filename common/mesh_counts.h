@@ -12,7 +12,8 @@ namespace shrefract {
 //   OFF   text: exactly "nv nf ne" on the counts line, nv vertex lines of 3+ numbers, then nf face
 //         lines "k i1 .. ik" (k >= 3) and nothing more (no face colour);
 //         binary: the bytes of nv vertices and nf faces;
-//   PLY   every element's count of lines (ascii) or of records (binary, lists walked);
+//   PLY   every element's count of lines, each with exactly the values its properties imply
+//         (ascii), or of records (binary, lists walked);
 //   STL   binary: exactly 84 + 50 n bytes for its n triangles; ASCII: 3 vertices per facet,
 //         every facet closed, "endsolid" at the end;
 //   OBJ   (no header) every "v" line is 3 numbers (or 4, or with 3 colour values) and every "f"

@@ -314,6 +314,16 @@ TEST(Mesh, CutShortFilesAreRefused) {
     badCoordinate.replace(badCoordinate.find("end_header\n") + 11, 1, "inf");
     expectInputError(writeText("index.ply", badIndex), "'3HHH' is not an integer");
     expectInputError(writeText("coordinate.ply", badCoordinate), "is not a number");
+    // A line holds exactly the values its properties imply. OpenMesh reads values, not lines, so
+    // one too many puts every later value out of step (found by the fuzzer: a first face "2 0 3 2",
+    // then "-4" read as a list length, grew a vector to 2 GB). A fourth coordinate, or a face
+    // list one shorter than its values, is refused.
+    const size_t firstVertex = asciiPly.find("end_header\n") + 11;
+    std::string extraCoordinate = asciiPly, shortList = asciiPly;
+    extraCoordinate.insert(asciiPly.find('\n', firstVertex), " 0.25");
+    shortList.replace(asciiPly.find("\n3 ") + 1, 1, "2");
+    expectInputError(writeText("coordinates.ply", extraCoordinate), "vertex 0 has 4 values, its header says 3");
+    expectInputError(writeText("list.ply", shortList), "face 0 has 4 values, its header says 3");
     // Records without properties take no bytes, so a binary file's size cannot bound their count
     // (found by the fuzzer: OpenMesh reserved 3 GB for 2^28 of them). The cube with one more
     // element of that kind, in either format, is refused.

@@ -16,8 +16,9 @@ namespace shrefract {
 //         (ascii), or of records (binary, lists walked);
 //   STL   binary: exactly 84 + 50 n bytes for its n triangles; ASCII: 3 vertices per facet,
 //         every facet closed, "endsolid" at the end;
-//   OBJ   (no header) every "v" line is 3 numbers (or 4, or with 3 colour values) and every "f"
-//         line 3 or more corners v, v/t, v//n or v/t/n with non-zero integer indices.
+//   OBJ   (no header) every "v" line is 3 numbers (or 4, or with 3 colour values), "vt" 1 to 3,
+//         "vn" 3, and every "f" line 3 or more corners v, v/t, v//n or v/t/n whose indices name a
+//         vertex, texture coordinate and normal of the file (negative: one before the line).
 // `ext` is the lower-case extension with its dot. Files it cannot classify are left to OpenMesh.
 void checkMeshCounts(const std::string& path, const std::string& ext);
 

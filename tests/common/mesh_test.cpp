@@ -360,6 +360,33 @@ TEST(Mesh, CutShortFilesAreRefused) {
                      "line 4: a face corner is not v, v/t, v//n or v/t/n");
 }
 
+// Every OBJ index names what the file has. OpenMesh writes the texture coordinate of a corner
+// whose vertex it does not have before it drops the face (found by the fuzzer: a
+// heap-buffer-overflow), and a texture coordinate or normal index past the file's loaded without
+// a word. A negative index counts back from its line; a face before its vertices is what OpenMesh
+// reads, and loads.
+TEST(Mesh, ObjIndicesNameWhatTheFileHas) {
+    const std::string cube = cubeObj(false);
+    const size_t lastFace = cube.rfind("\nf ") + 1;
+    const std::string lastLine = cube.substr(lastFace, cube.find('\n', lastFace) - lastFace);
+    const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\n";
+    const std::pair<std::string, std::string> bad[] = {
+        {std::string(cube).replace(lastFace, lastLine.size(), "f 1 2 9"), "names vertex 9 of 8"},
+        {tri + "f 1/1 2/2 3/4\n", "face corner 3/4 names texture coordinate 4 of 3"},
+        {tri + "f 1//1 2//1 3//2\n", "face corner 3//2 names normal 2 of 1"},
+        {tri + "f -1 -2 -4\n", "face corner -4 names vertex -4 of 3"},
+        {"f -1 -2 -3\n" + tri, "face corner -1 names vertex -1 of 0"},
+        {tri + "vt 0.5 x\nf 1 2 3\n", "line 8: a texture coordinate is not 1 to 3 numbers"},
+        {tri + "vn 0 1\nf 1 2 3\n", "line 8: a normal is not 3 numbers"},
+    };
+    for (const auto& [text, fragment] : bad) {
+        SCOPED_TRACE(fragment);
+        expectInputError(writeText("indices.obj", text), fragment);
+    }
+    EXPECT_EQ(loadMesh(writeText("forward.obj", "f 1 2 3\n" + tri)).triangles.size(), 1u);
+    EXPECT_EQ(loadMesh(writeText("relative.obj", tri + "f -3/-3/-1 -2/-2/-1 -1/-1/-1\n")).triangles.size(), 1u);
+}
+
 TEST(Mesh, InwardWoundClosedMeshIsFlipped) {
     MeshReport report;
     Mesh m = loadMesh(dataPath("scenes/inverted_cube.off"), &report);

@@ -421,49 +421,53 @@ void checkObj(const std::string& path, const std::string& text) {
     // the vertices it names.
     static const char* const kLists[3] = {"v", "vt", "vn"};
     static const char* const kNames[3] = {"vertex", "texture coordinate", "normal"};
-    uint64_t total[3] = {0, 0, 0}, seen[3] = {0, 0, 0};
-    for (int pass = 0; pass < 2; ++pass) {
+    auto list = [](const std::string& key) {
+        return int(std::find(std::begin(kLists), std::end(kLists), key) - std::begin(kLists));
+    };
+    uint64_t total[4] = {0, 0, 0, 0}, seen[4] = {0, 0, 0, 0};  // [3]: every other line
+    {
         std::istringstream in(text);
-        std::string line;
-        size_t number = 0;
-        auto bad = [&](const std::string& what) {
-            return inputError(path, "line " + std::to_string(number) + ": " + what);
-        };
-        while (std::getline(in, line)) {
-            ++number;
-            const std::vector<std::string> t = tokens(line);
-            if (t.empty()) continue;
-            for (int k = 0; k < 3; ++k)
-                if (t[0] == kLists[k]) ++(pass == 0 ? total : seen)[k];
-            if (pass == 0) continue;
-            const size_t n = t.size() - 1;
-            const bool numbers = std::all_of(t.begin() + 1, t.end(), isNumber);
-            // OpenMesh's OBJ reader asserts on a face without a readable corner (found by the
-            // fuzzer), so vertex and face lines are checked to the letter.
-            if (t[0] == "v") {
-                if ((n != 3 && n != 4 && n != 6 && n != 7) || !numbers)
-                    throw bad("a vertex is not 3 numbers (or 4, or with 3 colour values)");
-            } else if (t[0] == "vt") {
-                if (n < 1 || n > 3 || !numbers) throw bad("a texture coordinate is not 1 to 3 numbers");
-            } else if (t[0] == "vn") {
-                if (n != 3 || !numbers) throw bad("a normal is not 3 numbers");
-            } else if (t[0] == "f") {
-                if (t.size() < 4) throw bad("a face of fewer than 3 corners");
-                for (size_t c = 1; c < t.size(); ++c) {
-                    long long index[3];
-                    if (!parseObjCorner(t[c], index))
-                        throw bad("a face corner is not v, v/t, v//n or v/t/n with non-zero indices");
-                    // Every index names one the file has (a negative one, one before this line).
-                    // OpenMesh writes the texture coordinate of a corner whose vertex it does not
-                    // have before it drops the face (found by the fuzzer: "f 2/1 6 5" with one
-                    // vertex, a heap-buffer-overflow), and takes a texture coordinate or normal
-                    // index past the file's without a word.
-                    for (int k = 0; k < 3; ++k) {
-                        const uint64_t have = index[k] < 0 ? seen[k] : total[k];
-                        if (index[k] != 0 && uint64_t(std::llabs(index[k])) > have)
-                            throw bad("face corner " + t[c] + " names " + kNames[k] + " " +
-                                      std::to_string(index[k]) + " of " + std::to_string(have));
-                    }
+        for (std::string line; std::getline(in, line);)
+            if (const std::vector<std::string> t = tokens(line); !t.empty()) ++total[list(t[0])];
+    }
+    std::istringstream in(text);
+    std::string line;
+    size_t number = 0;
+    auto bad = [&](const std::string& what) {
+        return inputError(path, "line " + std::to_string(number) + ": " + what);
+    };
+    while (std::getline(in, line)) {
+        ++number;
+        const std::vector<std::string> t = tokens(line);
+        if (t.empty()) continue;
+        ++seen[list(t[0])];
+        const size_t n = t.size() - 1;
+        const bool numbers = std::all_of(t.begin() + 1, t.end(), isNumber);
+        // OpenMesh's OBJ reader asserts on a face without a readable corner (found by the
+        // fuzzer), so vertex and face lines are checked to the letter.
+        if (t[0] == "v") {
+            if ((n != 3 && n != 4 && n != 6 && n != 7) || !numbers)
+                throw bad("a vertex is not 3 numbers (or 4, or with 3 colour values)");
+        } else if (t[0] == "vt") {
+            if (n < 1 || n > 3 || !numbers) throw bad("a texture coordinate is not 1 to 3 numbers");
+        } else if (t[0] == "vn") {
+            if (n != 3 || !numbers) throw bad("a normal is not 3 numbers");
+        } else if (t[0] == "f") {
+            if (t.size() < 4) throw bad("a face of fewer than 3 corners");
+            for (size_t c = 1; c < t.size(); ++c) {
+                long long index[3];
+                if (!parseObjCorner(t[c], index))
+                    throw bad("a face corner is not v, v/t, v//n or v/t/n with non-zero indices");
+                // Every index names one the file has (a negative one, one before this line).
+                // OpenMesh writes the texture coordinate of a corner whose vertex it does not
+                // have before it drops the face (found by the fuzzer: "f 2/1 6 5" with one
+                // vertex, a heap-buffer-overflow), and takes a texture coordinate or normal
+                // index past the file's without a word.
+                for (int k = 0; k < 3; ++k) {
+                    const uint64_t have = index[k] < 0 ? seen[k] : total[k];
+                    if (index[k] != 0 && uint64_t(std::llabs(index[k])) > have)
+                        throw bad("face corner " + t[c] + " names " + kNames[k] + " " +
+                                  std::to_string(index[k]) + " of " + std::to_string(have));
                 }
             }
         }

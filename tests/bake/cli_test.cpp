@@ -57,8 +57,7 @@ TEST_P(BakeRejects, WithAClearErrorAndNoOutput) {
     EXPECT_EQ(r.code, 2) << r.out;  // bad input, CLI11's usage errors included (README)
     EXPECT_NE(r.out.find(c.expect), std::string::npos) << "message: " << r.out;
     EXPECT_FALSE(fs::exists(out));
-    for (auto& e : fs::directory_iterator(SHREFRACT_TEST_TMP))
-        EXPECT_NE(e.path().string().rfind(out + ".tmp", 0), 0u) << "left behind: " << e.path();
+    shrefract::test::expectNoStagedFileLeft(out);
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -183,8 +182,7 @@ TEST(BakeCli, InterruptStopsCleanlyAndWritesNothing) {
     EXPECT_NE(r.out.find("--resume"), std::string::npos) << r.out;
     EXPECT_FALSE(fs::exists(out));
     fs::remove_all(out + ".work");
-    for (auto& e : fs::directory_iterator(SHREFRACT_TEST_TMP))
-        EXPECT_NE(e.path().string().rfind(out + ".tmp", 0), 0u) << "left behind: " << e.path();
+    shrefract::test::expectNoStagedFileLeft(out);
 }
 
 }  // namespace

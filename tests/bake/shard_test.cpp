@@ -173,17 +173,20 @@ INSTANTIATE_TEST_SUITE_P(
 class MergeRejects : public ::testing::Test {
 protected:
     // Baked once per process, by the first test that runs (run() logs under the current test).
+    // ctest runs each case as its own process, two at a time: every file a case writes carries
+    // its process id, or one case's "precious" is truncated while another reads it.
     void SetUp() override {
-        static const std::vector<std::string> four = bakeShards("mr", 4),
-                                              other = bakeShards("mr_bounces", 2, " --max-bounces 16"),
-                                              three = bakeShards("mr_three", 3);
+        static const std::vector<std::string> four = bakeShards("mr" + pid_, 4),
+                                              other = bakeShards("mr_bounces" + pid_, 2, " --max-bounces 16"),
+                                              three = bakeShards("mr_three" + pid_, 3);
         four_ = four, other_ = other, three_ = three;
     }
+    const std::string pid_ = "_" + std::to_string(::getpid());
     std::vector<std::string> four_, other_, three_;
 
     // Runs the merge; it must fail with `expect` in its message and leave `precious` intact.
     void expectRefused(const std::string& args, const std::string& expect) {
-        const std::string out = tmp("mr_out.shrefract.exr");
+        const std::string out = tmp("mr_out" + pid_ + ".shrefract.exr");
         test::writeText(out, "precious");
         CommandResult r = run(kMerge + " " + out + " " + args);
         EXPECT_EQ(r.code, 2) << r.out;
@@ -192,8 +195,7 @@ protected:
         std::string s;
         f >> s;
         EXPECT_EQ(s, "precious");
-        for (auto& e : fs::directory_iterator(SHREFRACT_TEST_TMP))
-            EXPECT_EQ(e.path().string().find("mr_out.shrefract.exr.tmp"), std::string::npos) << e.path();
+        test::expectNoStagedFileLeft(out);
     }
 };
 

@@ -38,6 +38,14 @@ inline CommandResult run(const std::string& args) {
     return CommandResult{WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
 }
 
+// Where the file system refuses unnamed files, a tool stages `target` as the named temporary
+// TARGET.shrefract-tmp.PID.N (common/output.h): none may be left once the tool has exited.
+inline void expectNoStagedFileLeft(const std::string& target) {
+    const std::string prefix = target + ".shrefract-tmp.";
+    for (const auto& e : std::filesystem::directory_iterator(std::filesystem::path(target).parent_path()))
+        EXPECT_NE(e.path().string().rfind(prefix, 0), 0u) << "left behind: " << e.path();
+}
+
 inline void writeText(const std::string& path, const std::string& text) {
     std::filesystem::create_directories(std::filesystem::path(path).parent_path());
     std::ofstream(path) << text;

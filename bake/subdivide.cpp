@@ -1,9 +1,7 @@
 #include "bake/subdivide.h"
 
-#include <unistd.h>
-
-#include <cstdio>
 #include <filesystem>
+#include <sstream>
 
 // GCC 12's false "may be used uninitialized" inside OpenMesh's VectorT (as in common/mesh.cpp).
 #if defined(__GNUC__) && !defined(__clang__)
@@ -16,6 +14,7 @@
 
 #include "common/error.h"
 #include "common/mesh.h"
+#include "common/output.h"
 
 namespace shrefract {
 
@@ -44,19 +43,15 @@ SubdivisionResult subdivideMeshFile(const std::string& input, const std::string&
     }
     if (!ok) throw inputError(input, "OpenMesh's subdivider failed");
 
-    // OpenMesh picks the format by extension: the temporary keeps it.
-    const std::filesystem::path out(output);
-    const std::string tmp = (out.parent_path() / (out.stem().string() + ".tmp." + std::to_string(::getpid()) +
-                                                  out.extension().string())).string();
+    // OpenMesh picks the format by the target's extension; the bytes then go through the one
+    // staged write every output uses (common/output.h): fsynced, renamed, a link never replaced.
     // 9 significant digits: every float position written exactly (text formats).
-    if (!OpenMesh::IO::write_mesh(om, tmp, OpenMesh::IO::Options::Default, 9)) {
-        std::remove(tmp.c_str());
-        throw inputError(output, "cannot write (unknown extension or unwritable folder)");
-    }
-    if (std::rename(tmp.c_str(), output.c_str()) != 0) {
-        std::remove(tmp.c_str());
-        throw inputError(output, "cannot rename the temporary file to it");
-    }
+    std::ostringstream bytes;
+    const std::string ext = std::filesystem::path(output).extension().string();
+    if (ext.empty() ||
+        !OpenMesh::IO::write_mesh(om, bytes, ext, OpenMesh::IO::Options::Default, 9))
+        throw inputError(output, "cannot write a mesh with this extension (use .obj, .off, .ply or .stl)");
+    writeFile(output, bytes.str());
     return {om.n_vertices(), om.n_faces()};
 }
 

@@ -25,8 +25,9 @@ struct SubdivisionResult {
 
 // Reads `input` (checked as every mesh the bake reads), subdivides it `steps` times and writes
 // the result to `output` (format by extension; positions and triangles only, so readers derive
-// the normals of the smooth surface). Written to a temporary name and renamed. Throws
-// InputError naming the file.
+// the normals of the smooth surface). Written through writeFile (common/output.h): staged and
+// renamed, so a failure leaves an existing `output` as it was. Throws InputError naming the file
+// (IoError where the OS refuses the write).
 SubdivisionResult subdivideMeshFile(const std::string& input, const std::string& output,
                                     Subdivision scheme, int steps);
 

@@ -5,11 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <set>
 #include <string>
 
 #include "common/error.h"
 #include "common/mesh.h"
 #include "support/cli_run.h"
+#include "support/files.h"
 
 namespace shrefract {
 namespace {
@@ -59,6 +61,32 @@ TEST(Subdivide, BadInputIsRefusedByNameAndWritesNothing) {
         EXPECT_NE(std::string(e.what()).find("no_such_mesh.off"), std::string::npos) << e.what();
     }
     EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+// The output goes through the staged write every tool uses: a symbolic link at the target is
+// refused, not replaced by a rename (the file it points to keeps its bytes), and an extension
+// OpenMesh cannot write is refused by name with nothing left behind.
+TEST(Subdivide, TheOutputIsStagedAndALinkIsNeverReplaced) {
+    const std::filesystem::path dir = test::scratchFolder("subdivide");
+    const std::string in = (dir / "tetra.off").string();
+    test::writeText(in, kTetra);
+    const std::string precious = (dir / "precious.off").string();
+    test::writeText(precious, "precious");
+    const std::string link = (dir / "link.off").string();
+    std::filesystem::create_symlink(precious, link);
+    EXPECT_THROW(subdivideMeshFile(in, link, Subdivision::Loop, 1), InputError);
+    EXPECT_TRUE(std::filesystem::is_symlink(link));
+    EXPECT_EQ(test::readFile(precious), "precious");
+
+    const std::string odd = (dir / "out.xyz").string();
+    try {
+        subdivideMeshFile(in, odd, Subdivision::Loop, 1);
+        FAIL() << "no error";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("out.xyz"), std::string::npos) << e.what();
+    }
+    // Nothing but the three files this test planted.
+    EXPECT_EQ(test::listing(dir), (std::set<std::string>{"link.off", "precious.off", "tetra.off"}));
 }
 
 }  // namespace

@@ -65,7 +65,8 @@ struct RaySample {
     bool geometricEntry = false, backFacing = false;
 };
 
-RaySample traceRay(const Tracer& tracer, const ReferenceEnvironment& env, glm::vec3 eye, glm::vec3 d) {
+RaySample traceRay(const Tracer& tracer, const ReferenceEnvironment& env, glm::vec3 eye, glm::vec3 d,
+                   const ExitSource* exits) {
     RaySample out;
     SurfaceHit h;
     if (!tracer.hit(eye, d, &h)) {
@@ -81,8 +82,9 @@ RaySample traceRay(const Tracer& tracer, const ReferenceEnvironment& env, glm::v
     // Entry normal: the shading normal unless it faces away (then rule 3).
     glm::vec3 n = ns;
     if (glm::dot(n, omega) <= 0.0f) n = ng, out.geometricEntry = true;
-    const PathResult r = tracer.trace(h.p, n, omega, h.part);
+    PathResult r = tracer.trace(h.p, n, omega, h.part);
     out.flags = r.flags;
+    if (exits) r = exits->exit(tracer, h.p, n, omega, h.part);
     // The runtime's shading (shaders/shade.frag), with its interpolated normal for the Fresnel
     // term and the reflection.
     const float eta = static_cast<float>(medium.ior);
@@ -110,7 +112,7 @@ glm::vec2 pixelSample(int x, int y, int s, int spp) {
 }
 
 EvalBuffer renderReference(const Tracer& tracer, const ReferenceEnvironment& env,
-                           const ReferenceView& view, ReferenceStats* stats) {
+                           const ReferenceView& view, ReferenceStats* stats, const ExitSource* exits) {
     const auto start = std::chrono::steady_clock::now();
     EvalBuffer out;
     out.width = view.width;
@@ -129,14 +131,14 @@ EvalBuffer renderReference(const Tracer& tracer, const ReferenceEnvironment& env
                 for (int x = tile.cols().begin(); x < tile.cols().end(); ++x) {
                     const size_t i = static_cast<size_t>(y) * view.width + x;
                     // The pixel centre: direction buffer, coverage and the path statistics.
-                    const RaySample c = traceRay(tracer, env, view.eye, primaryRay(view, x, y));
+                    const RaySample c = traceRay(tracer, env, view.eye, primaryRay(view, x, y), exits);
                     glm::vec3 color = c.color;
                     if (spp > 1) {
                         color = glm::vec3(0.0f);
                         for (int s = 0; s < spp; ++s) {
                             const glm::vec2 o = pixelSample(x, y, s, spp);
                             color += traceRay(tracer, env, view.eye,
-                                              primaryRay(view, x + o.x, y + o.y)).color;
+                                              primaryRay(view, x + o.x, y + o.y), exits).color;
                         }
                         color /= float(spp);
                     }

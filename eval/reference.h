@@ -58,6 +58,16 @@ struct ReferenceStats {
     size_t tir = 0, capped = 0, reentered = 0, geometricNormal = 0, backFacing = 0;
 };
 
+// Where the renderer takes the exit of the path that enters at p (entry normal n, omega toward
+// the viewer, into part `part`): by default the traced path itself. Another source may return what
+// a direction representation fitted at that very point says instead (eval/pixel_fit.h).
+class ExitSource {
+public:
+    virtual ~ExitSource() = default;
+    virtual PathResult exit(const Tracer& tracer, glm::vec3 p, glm::vec3 n, glm::vec3 omega,
+                            int part) const = 0;
+};
+
 // Renders one frame, object at the origin (identity model, as shrefract-render). With spp > 1
 // the colour is the mean over the pixel's samples (background samples included: anti-aliased
 // silhouettes); the direction buffer and coverage stay those of the pixel centre, so angular
@@ -67,9 +77,11 @@ struct ReferenceStats {
 // with F = FresnelDielectric(n . omega, ior_q), exit and length from tracer.trace(hit, n, omega,
 // q) (omega = -ray direction; if n faces away from the viewer the geometric normal enters
 // instead, as rule 3 does later on the path), env = ReferenceEnvironment. Background pixels
-// show env(ray), coverage 0. Tiles of 16x16 pixels in parallel (TBB).
+// show env(ray), coverage 0. Tiles of 16x16 pixels in parallel (TBB). `exits`: where exit and
+// length come from instead of tracer.trace (null: the trace; the flags stay the traced path's).
 EvalBuffer renderReference(const Tracer& tracer, const ReferenceEnvironment& environment,
-                           const ReferenceView& view, ReferenceStats* stats = nullptr);
+                           const ReferenceView& view, ReferenceStats* stats = nullptr,
+                           const ExitSource* exits = nullptr);
 
 // Dispersion: colour channel c of buffer c, the coverage and direction buffer of `green` (the
 // middle channel). How the reference renders one index per RGB channel (three renders, each

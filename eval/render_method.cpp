@@ -21,6 +21,7 @@ struct RenderMethod::Impl {
     std::unique_ptr<Scene> scene;
     std::unique_ptr<Tracer> tracer;
     std::unique_ptr<ReferenceEnvironment> envImage;  // raytrace
+    std::unique_ptr<PixelFit> pixelFit;              // raytrace --exits other than exact
     std::unique_ptr<HeadlessContext> context;        // GL methods
     std::unique_ptr<Environment> env;
     std::unique_ptr<Refractor> refractor, bracket;
@@ -58,6 +59,13 @@ RenderMethod::RenderMethod(const RenderRequest& request, const Camera& camera, n
     if (r.method == "raytrace") {  // the CPU reference: no GL context at all
         m.envImage = std::make_unique<ReferenceEnvironment>(loadLatLong(r.envPath), !r.latLongLookup);
         m.timing = "CPU wall time, Embree, all cores";
+        if (r.exits != PixelExits::Exact) {
+            m.pixelFit = std::make_unique<PixelFit>(data, r.exits);
+            std::printf("exits: %s, fitted at every pixel's entry point to the bake's %dx%d grid\n",
+                        nameOf(r.exits), data.manifest["grid"][0].get<int>(),
+                        data.manifest["grid"][1].get<int>());
+        }
+        summary["exits"] = nameOf(r.exits);
         return;
     }
     m.context = createHeadlessContext(r.backend, r.width, r.height);
@@ -139,7 +147,7 @@ RenderedFrame RenderMethod::Impl::raytrace(const Camera& c, double* ms) const {
     ReferenceStats stats;
     const EvalBuffer b = r.ior.x > 0 ? renderDispersed(*scene, traceOptionsOfBake(bakeData(bake)),
                                                        *envImage, view, r.ior, &stats)
-                                     : renderReference(*tracer, *envImage, view, &stats);
+                                     : renderReference(*tracer, *envImage, view, &stats, pixelFit.get());
     RenderedFrame f;
     f.width = r.width, f.height = r.height;
     f.color.resize(b.pixelCount() * 4);

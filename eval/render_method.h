@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/bakefile.h"
+#include "eval/pixel_fit.h"
 #include "shrefract/baselines.h"
 #include "shrefract/context.h"
 #include "shrefract/render.h"
@@ -27,6 +28,7 @@ struct RenderRequest {
     int width = 1024, height = 1024;
     int frames = 5;             // GL methods: frames timed after the warm-up
     int spp = 1;                // raytrace: samples per pixel
+    PixelExits exits = PixelExits::Exact;  // raytrace: the traced exits, or a fit at each pixel
     glm::vec3 ior{0.0f};        // 0: the bake's own
     Backend backend = Backend::Egl;
     bool latLongLookup = false, verify = true, stageTimers = false;

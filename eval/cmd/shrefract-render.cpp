@@ -53,6 +53,7 @@ int main(int argc, char** argv) {
     bool smoothing = false;
     std::string method = "sh", scenePath, absorption, flicker, flickerJson;
     WymanTir tir = WymanTir::Reflect;
+    PixelExits exits = PixelExits::Exact;
     bool latLongLookup = false, noVerify = false;
     std::string iorText, bracketPath;
     RefractorOptions sh;  // defaults shown in --help
@@ -114,6 +115,10 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({"sh", "single", "wyman", "raytrace"}));
     cli::addEnumOption(app, "--wyman-tir", tir,
                        "Wyman at total internal reflection: reflect | straight | grazing");
+    cli::addEnumOption(app, "--exits", exits,
+                       "raytrace: each pixel's exit from its traced path (exact), or from the bake's "
+                       "representation fitted to the grid traced at the pixel's own entry point: "
+                       "fit | split | grid (docs/evaluation.md \"Pixel fits\"; slow: a grid per pixel)");
     app.add_flag("--latlong-lookup", latLongLookup,
                  "raytrace: look the environment up bilinearly in the lat-long image, not through "
                  "the runtime's cube map");
@@ -185,6 +190,10 @@ int main(int argc, char** argv) {
                 throw std::invalid_argument("--flicker: expected N:STEP with N >= 2, got '" + flicker + "'");
             if (!eye.empty()) throw std::invalid_argument("--flicker orbits: give --camera orbit:AZ,EL,DIST");
         }
+        if (exits != PixelExits::Exact && (method != "raytrace" || spp > 1 || !iorText.empty()))
+            throw std::invalid_argument(std::string("--exits ") + nameOf(exits) +
+                                        ": only --method raytrace at one sample per pixel and the "
+                                        "bake's own index fits a grid at each pixel");
         if (spp > 1 && method != "raytrace")
             throw std::invalid_argument("--spp " + std::to_string(spp) +
                                         ": only --method raytrace takes several samples per pixel");
@@ -224,7 +233,7 @@ int main(int argc, char** argv) {
         request.bracketPath = bracketPath, request.seamsOf = seamsOf, request.dumpDir = dumpDir;
         request.width = width, request.height = height, request.frames = frames, request.spp = spp;
         request.ior = ior;
-        request.backend = backend, request.tir = tir;
+        request.backend = backend, request.tir = tir, request.exits = exits;
         request.latLongLookup = latLongLookup, request.verify = !noVerify;
         request.stageTimers = stageTimers;
         request.sh = sh;

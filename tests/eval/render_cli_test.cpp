@@ -46,6 +46,11 @@ TEST(RenderCli, BadInputExitsNonZeroWithoutOutput) {
         {corrupt.string() + " --env x.exr --size 12by4", "--size"},
         {corrupt.string() + " --env x.exr --backend vulkan", "vulkan"},
         {corrupt.string() + " --env x.exr --camera orbit:1,2", "--camera"},
+        // A grid per pixel: the ray tracer's, at one sample per pixel, at the bake's own index.
+        {corrupt.string() + " --env x.exr --exits fit", "--exits fit: only --method raytrace"},
+        {corrupt.string() + " --env x.exr --method raytrace --exits grid --spp 4", "--exits grid"},
+        {corrupt.string() + " --env x.exr --method raytrace --exits split --ior 1.6", "--exits split"},
+        {corrupt.string() + " --env x.exr --method raytrace --exits table", "table"},
     };
     for (const Case& c : cases) {
         EXPECT_NE(run(c.args + " --out " + out.string(), log), 0) << c.args;

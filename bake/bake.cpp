@@ -16,6 +16,7 @@
 #include "common/checksum.h"
 #include "common/error.h"
 #include "common/frame.h"
+#include "common/limits.h"
 #include "common/sh.h"
 
 namespace shrefract {
@@ -65,8 +66,18 @@ struct BakePlan::Compression {
 
 BakePlan::BakePlan(const Scene& scene, const BakeOptions& opt, const std::string& inputPath)
     : scene_(scene), opt_(opt), input_(inputPath) {
-    opt_.errorOrder = storedErrorOrder(opt.errorOrder, opt.order, opt.grid);
-    if (!fitCanSolve(opt.fit, opt.order, opt.grid))
+    if (opt.basis == Basis::Grid) {
+        // The traced grid is the model: nothing to fit, and nothing missed at its directions.
+        if (opt.grid.count() > limits::kMaxGridBasis)
+            throw InputError(str("--basis grid stores every direction of --grid ", opt.grid.ToString(), " (",
+                                 opt.grid.count(), "), more than the ", limits::kMaxGridBasis,
+                                 " the runtime can hold per sample: use a coarser --grid"));
+        opt_.order = 0;
+        opt_.errorOrder = -1;
+    } else {
+        opt_.errorOrder = storedErrorOrder(opt.errorOrder, opt.order, opt.grid);
+    }
+    if (opt.basis == Basis::Sh && !fitCanSolve(opt.fit, opt.order, opt.grid))
         throw InputError(str("--order ", opt.order, " stores ", shEvenCount(opt.order), " coefficients, more than the ",
                              opt.grid.count(), " directions of --grid ", opt.grid.ToString(), ": the ",
                              nameOf(opt.fit), " fit needs at least as many (a finer --grid, a lower "
@@ -90,8 +101,9 @@ void BakePlan::prepareTracing() const {
     std::call_once(prepared_, [&] {
         const int J = opt_.grid.count();
         auto c = std::make_unique<Compression>();
-        c->fit = std::make_unique<SampleFit>(opt_.grid, opt_.order, opt_.fit, opt_.weighting,
-                                             opt_.filterWidth, opt_.cacheDir);
+        if (opt_.basis == Basis::Sh)
+            c->fit = std::make_unique<SampleFit>(opt_.grid, opt_.order, opt_.fit, opt_.weighting,
+                                                 opt_.filterWidth, opt_.cacheDir);
         if (opt_.errorOrder >= 0)
             c->residual = std::make_unique<ResidualFitter>(opt_.grid, opt_.order, opt_.errorOrder);
         c->dirs.resize(J);
@@ -115,9 +127,9 @@ SliceResult BakePlan::bakeSlice(size_t beginBatch, size_t endBatch, const SliceP
     const Compression& compression = *compression_;
     const std::vector<glm::vec3>& dirs = compression.dirs;
     const std::vector<uint32_t>& order = compression.order;
-    const bool weighted = compression.fit->needsPaths();
+    const bool weighted = compression.fit && compression.fit->needsPaths();
     const size_t n = L.position.size();
-    const int K = shEvenCount(opt.order);
+    const int K = basisCoefficients(opt.basis, opt.order, opt.grid);
     const int J = opt.grid.count();
     endBatch = std::min(endBatch, batchCount());
     beginBatch = std::min(beginBatch, endBatch);
@@ -180,7 +192,10 @@ SliceResult BakePlan::bakeSlice(size_t beginBatch, size_t endBatch, const SliceP
             // 2. Compress the batch: the projection W = M R, one GEMM; or one weighted solve per
             // sample, the band filter applied to its weights.
             auto tGemm = Clock::now();
-            compression.fit->fit(R, weighted ? batchPaths.data() : nullptr, int(batchCount), Wt);
+            if (compression.fit)
+                compression.fit->fit(R, weighted ? batchPaths.data() : nullptr, int(batchCount), Wt);
+            else
+                Wt = R.transpose();  // the grid basis: weight j is the traced value at direction j
             // 3. Store its weights, and the error model of what they miss at the grid directions.
             for (int k = 0; k < K; ++k)
                 std::copy_n(Wt.col(k).data(), 4 * batchCount,
@@ -254,7 +269,7 @@ nlohmann::json BakePlan::manifest(const BakeStats& stats) const {
                          {"meshChecksum", p.mesh.checksum()},
                          {"triangles", p.mesh.triangles.size()}});
     }
-    return {
+    nlohmann::json m = {
         {"input", absolute(input_)},
         {"grid", {opt_.grid.nTheta, opt_.grid.nPhi}},
         {"filterWidth", opt_.filterWidth},
@@ -264,26 +279,34 @@ nlohmann::json BakePlan::manifest(const BakeStats& stats) const {
         {"maxBounces", opt_.trace.maxBounces},
         {"tracer", opt_.coherent ? "coherent" : "scalar"},
         {"media", media},
-        {"sh", {{"convention", "real, orthonormal, no Condon-Shortley phase (docs/conventions.md)"},
-                {"stored", "l+m even, even order: l = 0..L, m = -l, -l+2, ..., l"},
-                {"channels", "exit x, y, z (object space), path length"}}},
         {"frame", "Duff et al. 2017 orthonormal basis from the shading normal, z = normal"},
         {"layout", layoutInfo},
         {"stats", stats.ToJson()},
     };
+    if (opt_.basis == Basis::Grid)
+        m["gridBasis"] = {{"stored", "the traced exit at grid direction j = i * nPhi + k (docs/format.md)"},
+                          {"interpolation", "bilinear in (theta, phi), wrapping in phi, reflected across the pole"},
+                          {"channels", "exit x, y, z (object space), path length"}};
+    else
+        m["sh"] = {{"convention", "real, orthonormal, no Condon-Shortley phase (docs/conventions.md)"},
+                   {"stored", "l+m even, even order: l = 0..L, m = -l, -l+2, ..., l"},
+                   {"channels", "exit x, y, z (object space), path length"}};
+    return m;
 }
 
 BakeData BakePlan::data(std::vector<float> weights, std::vector<float> errors,
                         const BakeStats& stats) const {
     BakeData d;
+    d.basis = opt_.basis;
     d.order = opt_.order;
+    d.grid = opt_.grid;
     d.precision = opt_.precision;
     d.layout = layout_;
     d.weights = std::move(weights);
     d.errorOrder = opt_.errorOrder < 0 ? -1 : opt_.errorOrder;
     d.errors = std::move(errors);
     d.manifest = manifest(stats);
-    if (opt_.fit != Fit::Projection) {
+    if (opt_.basis == Basis::Sh && opt_.fit != Fit::Projection) {
         // The weighted fit solves even rank-deficient problems (bake/fit.cpp's double path); if
         // a least-squares fit still comes out non-finite, say so, not that a weight is NaN.
         const auto bad = std::find_if(d.weights.begin(), d.weights.end(), [](float w) { return !std::isfinite(w); });

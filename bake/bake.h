@@ -37,6 +37,9 @@ struct BakeProgress {
 };
 
 struct BakeOptions {
+    // Sh: fit each sample's grid with SH (the paper). Grid: store the traced grid itself, one
+    // coefficient per direction (docs/bake.md "The grid basis"): no fit, no error model, order 0.
+    Basis basis = Basis::Sh;
     int order = 12;          // SH order L; 12 by the charts (docs/bake.md), the paper's is 8
     LayoutKind layout = LayoutKind::Joining;
     int rate = 0;            // joining: grid steps per triangle edge; 0: from `samples`

@@ -67,6 +67,7 @@ ShardSlice sliceOf(const json& manifest) {
 // Scene and options that rebuild the bake `identity` describes (the merge's plan).
 BakeOptions optionsOf(const json& id) {
     BakeOptions o;
+    o.basis = parseInput<Basis>(id.value("basis", "sh"));
     o.order = id.value("order", -1);
     if (o.order < 0 || o.order > 100) throw InputError(str("SH order ", o.order, " is absurd"));
     o.precision = parseInput<Precision>(id.value("precision", ""));
@@ -164,6 +165,7 @@ json shardIdentity(const BakePlan& plan) {
     json id = plan.manifest(BakeStats{});
     id.erase("stats");
     const BakeOptions& o = plan.options();
+    if (o.basis == Basis::Grid) id["basis"] = nameOf(o.basis);  // absent: sh, as before version 4
     id["order"] = o.order;
     id["precision"] = nameOf(o.precision);
     id["rate"] = plan.layout().rate;
@@ -178,7 +180,9 @@ ShardData bakeShard(const BakePlan& plan, ShardSlice slice, const SliceProgress&
     const auto [b0, b1] = shardBatches(plan.batchCount(), slice);
     SliceResult r = plan.bakeSlice(b0, b1, base);
     ShardData d;
+    d.basis = plan.options().basis;
     d.order = plan.options().order;
+    d.grid = plan.options().grid;
     d.sampleCount = r.count;
     d.weights = std::move(r.weights);
     d.errorOrder = plan.options().errorOrder < 0 ? -1 : plan.options().errorOrder;
@@ -215,7 +219,7 @@ std::string shardMismatch(const ShardData& shard, const json& identity, ShardSli
 BakeResult mergeShards(const BakePlan& plan, const std::vector<std::string>& paths) {
     const json identity = shardIdentity(plan);
     const size_t n = plan.sampleCount(), batches = plan.batchCount();
-    const int K = shEvenCount(plan.options().order);
+    const int K = basisCoefficients(plan.options().basis, plan.options().order, plan.options().grid);
 
     // The slices, each once.
     std::map<int, std::string> byIndex;

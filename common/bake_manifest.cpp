@@ -131,6 +131,48 @@ int readErrorOrder(const json& m) {
     return order;
 }
 
+void writeBasis(json& m, Basis basis, int order, const DirectionGrid& grid) {
+    m["order"] = order;
+    m["coefficients"] = basisCoefficients(basis, order, grid);
+    if (basis == Basis::Grid) {
+        m["basis"] = nameOf(basis);
+        m["grid"] = {grid.nTheta, grid.nPhi};  // the coefficients' layout, so the reader's to check
+    } else {
+        m.erase("basis");  // an SH bake's "grid" is the caller's description of its tracing
+    }
+}
+
+int readBasis(const json& m, Basis* basis, int* order, DirectionGrid* grid) {
+    *basis = Basis::Sh;
+    if (m.contains("basis")) {
+        if (!m["basis"].is_string()) throw InputError("manifest \"basis\" is not a string");
+        *basis = parseInput<Basis>(m["basis"].get<std::string>());
+    }
+    *order = manifestInt(m, "order");
+    if (*order < 0 || *order > limits::kMaxOrder)
+        throw InputError(str("SH order ", *order, " is not in [0, ", limits::kMaxOrder, "]"));
+    if (*basis == Basis::Grid && *order != 0)
+        throw InputError(str("a grid-basis bake has SH order 0, not ", *order));
+    const auto g = m.find("grid");
+    const bool gridArray = g != m.end() && g->is_array() && g->size() == 2 && (*g)[0].is_number_integer() &&
+                           (*g)[1].is_number_integer();
+    if (*basis == Basis::Grid || gridArray) {
+        const std::vector<int> g = manifestInts(m, "grid", 2);
+        if (const std::string problem = gridProblem(g[0], g[1]); !problem.empty())
+            throw InputError("manifest \"grid\": " + problem);
+        grid->nTheta = g[0], grid->nPhi = g[1];
+    }
+    if (*basis == Basis::Grid && grid->count() > limits::kMaxGridBasis)
+        throw InputError(str("a grid-basis bake of ", grid->ToString(), " stores ", grid->count(),
+                             " coefficients per sample, more than ", limits::kMaxGridBasis));
+    const int K = basisCoefficients(*basis, *order, *grid);
+    if (manifestInt(m, "coefficients") != K)
+        throw InputError(str("manifest says ", manifestInt(m, "coefficients"), " coefficients, ",
+                             *basis == Basis::Grid ? "grid " + grid->ToString() : str("order ", *order),
+                             " has ", K));
+    return K;
+}
+
 }  // namespace shrefract::format_internal
 
 namespace shrefract {

@@ -91,15 +91,9 @@ BakeData readParts(Imf::MultiPartInputFile& file, const ReadOptions& options, ui
         layoutInfo = *layout;
     }
 
-    d.order = manifestInt(m, "order");
-    if (d.order < 0 || d.order > limits::kMaxOrder)
-        throw InputError(str("SH order ", d.order, " is not in [0, ", limits::kMaxOrder, "]"));
     if (const std::string problem = manifestProblem(m); !problem.empty())
         throw InputError("manifest: " + problem);
-    const int K = d.coefficientCount();
-    if (manifestInt(m, "coefficients") != K)
-        throw InputError(str("manifest says ", manifestInt(m, "coefficients"),
-                             " coefficients, order ", d.order, " has ", K));
+    const int K = readBasis(m, &d.basis, &d.order, &d.grid);
     if (!m.contains("precision") || !m["precision"].is_string())
         throw InputError("manifest has no \"precision\"");
     d.precision = parseInput<Precision>(m["precision"].get<std::string>());

@@ -74,6 +74,14 @@ std::string inconsistency(const BakeData& d) {
     const SurfaceLayout& L = d.layout;
     if (d.order < 0 || d.order > limits::kMaxOrder)
         return str("SH order ", d.order, " is not in [0, ", limits::kMaxOrder, "]");
+    if (const std::string problem = gridProblem(d.grid.nTheta, d.grid.nPhi); !problem.empty())
+        return "grid: " + problem;
+    if (d.basis == Basis::Grid && d.grid.count() > limits::kMaxGridBasis)
+        return str("a grid-basis bake of ", d.grid.ToString(), " has more than ",
+                   limits::kMaxGridBasis, " directions");
+    if (d.basis == Basis::Grid && (d.order != 0 || d.errorOrder >= 0))
+        return str("a grid-basis bake has SH order 0 and no error model, not order ", d.order,
+                   " and error model ", d.errorOrder);
     const size_t K = size_t(d.coefficientCount());
     const size_t N = L.position.size();
     if (L.normal.size() != N || L.part.size() != N)

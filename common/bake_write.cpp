@@ -118,8 +118,7 @@ void writeBake(const std::string& path, const BakeData& data) {
     json m = data.manifest.is_null() ? json::object() : data.manifest;
     m["format"] = "shrefract";
     m["version"] = kFormatVersion;
-    m["order"] = data.order;
-    m["coefficients"] = data.coefficientCount();
+    writeBasis(m, data.basis, data.order, data.grid);
     m["precision"] = nameOf(data.precision);
     m["sampleCount"] = L.sampleCount();
     m["mu"] = {L.muWidth, L.muHeight};

@@ -9,13 +9,15 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include "common/direction_grid.h"
 #include "shrefract/enum_names.h"
 
 namespace shrefract {
 
-// 2: per-part and manifest checksums, the layout kind and the chart layouts; 3: the error model
-// (docs/format.md "Versions"). Readers take version 1 too, unverified, as a joining layout.
-constexpr int kFormatVersion = 3;
+// 2: per-part and manifest checksums, the layout kind and the chart layouts; 3: the error model;
+// 4: the grid basis (docs/format.md "Versions"). Readers take version 1 too, unverified, as a
+// joining layout.
+constexpr int kFormatVersion = 4;
 
 // The error model stores ln(angle + kErrorOffset) (radians): the offset keeps the logarithm of an
 // exact fit finite, and a prediction at or below it reads as no error at all.
@@ -42,6 +44,19 @@ template <> struct EnumNames<Precision> {
     static constexpr NamedValue<Precision> table[] = {
         {Precision::F32, "f32"}, {Precision::F16, "f16"}, {Precision::U8, "u8"}};
 };
+
+// What a sample's coefficients are (manifest "basis"; docs/format.md "weights"):
+//   Sh    the even real SH through `order` (paper §4.2): D(w) = sum_k weight_k y_k(w).
+//   Grid  the traced grid itself, one coefficient per grid direction j: D(w) = sum_j weight_j
+//         B_j(w), B_j the grid's bilinear interpolation (DirectionGrid::interpolate), at most four
+//         non-zero anywhere. No fit and so no fitting error at the grid directions; more bytes.
+enum class Basis { Sh, Grid };
+template <> struct EnumNames<Basis> {
+    static constexpr const char* what = "basis";
+    static constexpr NamedValue<Basis> table[] = {{Basis::Sh, "sh"}, {Basis::Grid, "grid"}};
+};
+// Coefficients per sample: shEvenCount(order) for Sh, grid.count() for Grid.
+int basisCoefficients(Basis basis, int order, const DirectionGrid& grid);
 
 // One texel of the rho layout. kind Sample: shows mu sample a. kind Correction: the texel just
 // outside a triangle's hypotenuse, value = D[a] + D[b] - D[c] (v11 = v01 + v10 - v00), so that
@@ -141,11 +156,14 @@ void drawPoints(const SurfaceLayout& layout, std::vector<glm::vec3>* positions,
 
 struct BakeData {
     nlohmann::json manifest;  // everything descriptive: see docs/format.md
-    int order = 8;            // L
+    Basis basis = Basis::Sh;
+    int order = 8;            // L (Sh); 0 for Grid
+    DirectionGrid grid;       // the traced directions (manifest "grid"); Grid: the coefficients
     Precision precision = Precision::F32;
     SurfaceLayout layout;
-    // SH weights, dequantized: weights[(k * sampleCount + i) * 4 + c], k in even order
-    // (shEvenIndex), c = exit x, y, z (object space) and path length.
+    // Weights, dequantized: weights[(k * sampleCount + i) * 4 + c], k in even order
+    // (shEvenIndex) for Sh, the grid direction index j for Grid; c = exit x, y, z (object space)
+    // and path length.
     std::vector<float> weights;
     // For U8 only: per coefficient k and channel c, value = scale * code + offset.
     std::vector<float> u8Scale, u8Offset;  // shEvenCount(order) * 4 each
@@ -156,7 +174,7 @@ struct BakeData {
     int errorOrder = -1;
     std::vector<float> errors;
 
-    int coefficientCount() const;  // shEvenCount(order)
+    int coefficientCount() const;  // basisCoefficients(basis, order, grid)
     int errorCoefficientCount() const;  // shEvenCount(errorOrder), 0 without a model
 
     // Not stored: what readBake noticed that the caller should tell the user (e.g. a version 1
@@ -202,7 +220,9 @@ BakeData readBake(const std::string& path, const ReadOptions& options = {});
 // write them; shrefract-merge (bake/shard.h) assembles a bake's shards into its bake file.
 struct ShardData {
     nlohmann::json manifest;    // must hold a "shard" object; the writer adds the format keys
+    Basis basis = Basis::Sh;    // as BakeData's
     int order = 8;              // L
+    DirectionGrid grid;         // as BakeData's
     size_t sampleCount = 0;     // samples in this slice
     std::vector<float> weights; // [(k * sampleCount + i) * 4 + c], as BakeData::weights
     int errorOrder = -1;        // the error model, as BakeData's

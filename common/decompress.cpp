@@ -23,6 +23,18 @@ glm::vec3 localViewFromEye(const SurfaceLayout& layout, int i, glm::vec3 eye) {
 }
 
 glm::vec4 decompressSample(const BakeData& bake, int i, glm::vec3 wLocal, int order) {
+    const size_t n = bake.layout.position.size();
+    if (bake.basis == Basis::Grid) {
+        int index[4];
+        double weight[4];
+        const int count = bake.grid.interpolate(glm::dvec3(glm::normalize(wLocal)), index, weight);
+        glm::vec4 d(0.0f);
+        for (int c = 0; c < count; ++c) {
+            const float* w = &bake.weights[(index[c] * n + i) * 4];
+            d += float(weight[c]) * glm::vec4(w[0], w[1], w[2], w[3]);
+        }
+        return d;
+    }
     int L = (order < 0 || order > bake.order) ? bake.order : order;
     int K = shEvenCount(L);
     float basis[512];
@@ -30,7 +42,6 @@ glm::vec4 decompressSample(const BakeData& bake, int i, glm::vec3 wLocal, int or
     // Below the tangent plane the mirrored function is meant: the stored functions are all
     // even in z, so evaluating at (x, y, z) or (x, y, -z) is the same.
     shEvalEven(L, glm::normalize(wLocal), basis);
-    const size_t n = bake.layout.position.size();
     glm::vec4 d(0.0f);
     for (int k = 0; k < K; ++k) {
         const float* w = &bake.weights[(k * n + i) * 4];

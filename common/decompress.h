@@ -18,7 +18,8 @@ glm::vec3 localViewDirection(const SurfaceLayout& layout, int i, glm::vec3 omega
 glm::vec3 localViewFromEye(const SurfaceLayout& layout, int i, glm::vec3 eye);
 
 // D_mu at sample i for the local view direction wLocal: sum over stored coefficients through
-// order `order` (-1: all stored) of weight x y_k(wLocal). Returns (exit x, y, z, length), the
+// order `order` (-1: all stored) of weight x y_k(wLocal); for a grid-basis bake, the bilinear
+// interpolation of the traced grid (DirectionGrid::interpolate; `order` is ignored). Returns (exit x, y, z, length), the
 // exit direction in object space and NOT normalized (the runtime normalizes after filtering).
 glm::vec4 decompressSample(const BakeData& bake, int i, glm::vec3 wLocal, int order = -1);
 

@@ -149,6 +149,12 @@ json openManifest(Imf::MultiPartInputFile& file, bool verify, int* version);
 json errorModelInfo(int order);
 // The order of the manifest's "errorModel", checked against its coefficient count.
 int readErrorOrder(const json& m);
+// The coefficients' basis in a manifest: "order", "coefficients" and, for the grid basis only,
+// "basis": "grid" and "grid" (a file without "basis" is SH, as every file before version 4).
+void writeBasis(json& m, Basis basis, int order, const DirectionGrid& grid);
+// Reads them back, checks "coefficients" against the basis and returns that count. The grid is
+// required by the grid basis; an SH file without one keeps `*grid` as it is.
+int readBasis(const json& m, Basis* basis, int* order, DirectionGrid* grid);
 
 // What a version 2 file says its parts' checksums are, and the check against what was read.
 class Verifier {

@@ -13,6 +13,7 @@ constexpr int kMaxRate = 64;     // grid steps per triangle edge (2145 samples p
 constexpr int kMaxBounces = 10000;
 constexpr double kMaxFilterWidth = 1000.0;  // bands
 constexpr int kMinGrid = 2, kMaxGrid = 1024;  // directions per axis of the hemisphere grid
+constexpr int kMaxGridBasis = 2048;  // directions of a grid-basis bake: GL 4.5's array layers
 constexpr int kMaxTextureSize = 32768;        // any side of the mu, rho or neighbour-list parts
 
 }  // namespace shrefract::limits

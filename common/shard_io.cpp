@@ -25,12 +25,7 @@ ShardData readShardParts(Imf::MultiPartInputFile& file, bool weights) {
     if (version < 2) throw InputError(str("shard of format version ", version, " (shards are 2+)"));
     const Verifier verifier(m, true);
     ShardData d;
-    d.order = manifestInt(m, "order");
-    if (d.order < 0 || d.order > 100) throw InputError(str("SH order ", d.order, " is absurd"));
-    const int K = shEvenCount(d.order);
-    if (manifestInt(m, "coefficients") != K)
-        throw InputError(str("manifest says ", manifestInt(m, "coefficients"),
-                             " coefficients, order ", d.order, " has ", K));
+    const int K = readBasis(m, &d.basis, &d.order, &d.grid);
     if (m.value("precision", "") != "f32") throw InputError("shard weights are not f32");
     const int N = manifestInt(m, "sampleCount");
     const std::vector<int> size = manifestInts(m, "weightsSize", 2);
@@ -63,7 +58,7 @@ ShardData readShardParts(Imf::MultiPartInputFile& file, bool weights) {
 }  // namespace
 
 void writeShard(const std::string& path, const ShardData& shard) {
-    const int K = shEvenCount(shard.order);
+    const int K = basisCoefficients(shard.basis, shard.order, shard.grid);
     if (shard.order < 0 || shard.weights.size() != size_t(K) * shard.sampleCount * 4)
         throw std::invalid_argument(str("writeShard(", path, "): ", shard.weights.size(),
                                         " weights, expected ", K, " coefficients x ",
@@ -84,8 +79,7 @@ void writeShard(const std::string& path, const ShardData& shard) {
     json m = shard.manifest;
     m["format"] = "shrefract";
     m["version"] = kFormatVersion;
-    m["order"] = shard.order;
-    m["coefficients"] = K;
+    writeBasis(m, shard.basis, shard.order, shard.grid);
     m["precision"] = "f32";
     m["sampleCount"] = shard.sampleCount;
     m["weightsSize"] = {width, height};

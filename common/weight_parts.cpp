@@ -13,7 +13,10 @@
 
 namespace shrefract {
 
-int BakeData::coefficientCount() const { return shEvenCount(order); }
+int basisCoefficients(Basis basis, int order, const DirectionGrid& grid) {
+    return basis == Basis::Grid ? grid.count() : shEvenCount(order);
+}
+int BakeData::coefficientCount() const { return basisCoefficients(basis, order, grid); }
 int BakeData::errorCoefficientCount() const { return errorOrder < 0 ? 0 : shEvenCount(errorOrder); }
 
 namespace format_internal {

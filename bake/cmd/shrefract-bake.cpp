@@ -39,6 +39,12 @@ int main(int argc, char** argv) {
     std::string targetReport;
     app.add_option("input", input, "mesh (.obj .off .ply .stl), scene (.json) or glTF (.gltf .glb)")->required();
     app.add_option("-o,--output", output, "output file, NAME.shrefract.exr")->required();
+    std::string basis = nameOf(opt.basis);
+    app.add_option("--basis", basis,
+                   "sh: fit each sample's directions with SH (the paper); grid: store the traced "
+                   "grid itself, one RGBA8 texel per --grid direction, no fit (docs/bake.md "
+                   "\"The grid basis\")")
+        ->capture_default_str()->check(CLI::IsMember({"sh", "grid"}));
     app.add_option("--order", opt.order, "SH order L: bands 0..L")->capture_default_str()->check(CLI::Range(0, limits::kMaxOrder));
     std::string layout = "joining", texels;
     app.add_option("--layout", layout,
@@ -124,6 +130,14 @@ int main(int argc, char** argv) {
             opt.rate = rate;
             opt.samples = samples;
             opt.layout = parseName<LayoutKind>(layout);
+            opt.basis = parseName<Basis>(basis);
+            if (opt.basis == Basis::Grid) {
+                for (const char* o : {"--order", "--fit", "--fit-weighting", "--filter", "--error-order"})
+                    if (app.count(o) > 0)
+                        throw InputError(str(o, " shapes an SH fit; --basis grid stores the traced grid unfitted"));
+                if (targetError > 0 || budgetMB > 0)
+                    throw InputError("--target-error and --budget search SH models; not with --basis grid");
+            }
             if (opt.layout != LayoutKind::Joining && rate > 0)
                 throw InputError("--rate is for --layout joining; chart layouts take --samples or --texels");
             if (opt.layout == LayoutKind::Joining && !texels.empty())
@@ -332,9 +346,11 @@ int main(int argc, char** argv) {
                         "geometric-normal fallback %.3f%%, leaked %.3f%%\n",
                         pct(s.tir), pct(s.capped), pct(s.softCapped), pct(s.reentered), pct(s.geometricNormal),
                         pct(s.leaked));
-            std::printf("  file        %.1f MB, order %d, %d coefficients, %s\n",
-                        std::filesystem::file_size(output) / 1e6, opt.order, res.data.coefficientCount(),
-                        nameOf(opt.precision));
+            std::printf("  file        %.1f MB, %s, %d coefficients, %s\n",
+                        std::filesystem::file_size(output) / 1e6,
+                        opt.basis == Basis::Grid ? ("grid basis " + opt.grid.ToString()).c_str()
+                                                 : ("order " + std::to_string(opt.order)).c_str(),
+                        res.data.coefficientCount(), nameOf(opt.precision));
             return int(cli::kOk);
         } catch (const Cancelled&) {
             if (!checkpointDir.empty())

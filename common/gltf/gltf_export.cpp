@@ -103,7 +103,12 @@ int glassMaterial(tinygltf::Model& model, float ior, glm::vec3 kappa, std::vecto
     return static_cast<int>(model.materials.size()) - 1;
 }
 
-void checkExportable(const SurfaceLayout& L) {
+void checkExportable(const BakeData& d) {
+    const SurfaceLayout& L = d.layout;
+    // SHREFRACT_sh_refraction version 1 carries SH weights; the web material evaluates SH.
+    if (d.basis != Basis::Sh)
+        throw InputError("a grid-basis bake (" + d.grid.ToString() +
+                         "): SHREFRACT_sh_refraction carries SH weights; bake with --basis sh");
     if (L.isChartLayout())
         throw InputError(std::string("a ") + nameOf(L.kind) +
                          " (chart) layout: the glTF export draws the joining layout's sample grid; "
@@ -180,7 +185,7 @@ tinygltf::Primitive samplePrimitive(BinaryBuffer& bin, const SurfaceLayout& L,
 nlohmann::json addRefraction(tinygltf::Model& model, BinaryBuffer& bin, const BakeData& d,
                              const std::string& name) {
     const SurfaceLayout& L = d.layout;
-    checkExportable(L);
+    checkExportable(d);
     const size_t N = static_cast<size_t>(L.sampleCount());
     const float ior = frontIor(d);
     const glm::vec3 kappa = frontAbsorption(d);
@@ -401,7 +406,7 @@ void gatherIntoOneBuffer(tinygltf::Model& model) {
 
 std::vector<uint8_t> exportInto(const BakeData& bake, const std::string& scenePath,
                                 const std::vector<GltfEnvironment>& environments) {
-    checkExportable(bake.layout);
+    checkExportable(bake);
     // The parts as the bake read them, and where each came from.
     tinygltf::Model model;
     readGltfModel(scenePath, model, true);

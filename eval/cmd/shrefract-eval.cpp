@@ -44,8 +44,9 @@ void printTable(const nlohmann::json& r) {
                         c["ceiling"]["lengthError"]["mean"].get<double>());
         std::printf("\n");
     };
-    std::printf("direction error, degrees (%zu pairs, order %d)%s\n", r["pairs"].get<size_t>(),
-                r["order"].get<int>(),
+    const std::string basis = r.value("basis", "sh");
+    std::printf("direction error, degrees (%zu pairs, %s)%s\n", r["pairs"].get<size_t>(),
+                basis == "sh" ? ("order " + std::to_string(r["order"].get<int>())).c_str() : basis.c_str(),
                 ceiling ? "; right: the data ceiling, the raw grid interpolated bilinearly" : "");
     std::printf("  %-11s %7s  %8s %8s %8s %8s %8s   %8s", "paths", "share", "mean", "median", "p95",
                 "p99", "max", "len err");
@@ -273,6 +274,8 @@ int main(int argc, char** argv) {
             throw std::invalid_argument("--order " + std::to_string(order) + ": " + bakePath +
                                         " stores orders 0.." + std::to_string(bake.order) +
                                         " (-1: all)");
+        if (adaptive->parsed() && bake.basis != Basis::Sh)
+            throw InputError(bakePath + ": adaptive drops SH bands; this bake stores the grid basis");
         if (adaptive->parsed()) {
             Scene scene = sceneOfBake(bake, bakePath, scenePath);
             const size_t n = bake.layout.position.size();

@@ -36,7 +36,12 @@ Decompression::Decompression(const BakeData& d, const RefractorOptions& options,
                     : options.halfWeights           ? WeightFormat::Float16
                                                     : WeightFormat::Float32;
     limits_.unormWeights = weightFormat_ == WeightFormat::Unorm8;
-    const int K = shEvenCount(maxOrder);
+    const bool grid = d.basis == Basis::Grid;
+    if (grid && !limits_.weightArray)
+        throw std::invalid_argument("shrefract: a grid-basis bake needs the modern preset (its " +
+                                    std::to_string(d.coefficientCount()) +
+                                    " weight layers go in one texture array)");
+    const int K = grid ? d.coefficientCount() : shEvenCount(maxOrder);
     if (limits_.unormWeights) {
         u8Scale_.resize(size_t(K) * 4);
         u8Offset_.resize(size_t(K) * 4);
@@ -64,9 +69,12 @@ Decompression::Decompression(const BakeData& d, const RefractorOptions& options,
         GLint maxLayers = 256;
         glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &maxLayers);
         if (K > maxLayers)
-            throw std::runtime_error("shrefract: order " + std::to_string(maxOrder) + " needs " +
-                                     std::to_string(K) + " weight layers, GL allows " +
-                                     std::to_string(maxLayers) + " (set maxOrder lower)");
+            throw std::runtime_error("shrefract: " +
+                                     (grid ? "grid " + d.grid.ToString()
+                                           : "order " + std::to_string(maxOrder)) +
+                                     " needs " + std::to_string(K) + " weight layers, GL allows " +
+                                     std::to_string(maxLayers) +
+                                     (grid ? " (bake a coarser --grid)" : " (set maxOrder lower)"));
         glGenTextures(1, &weightArray_);
         glBindTexture(GL_TEXTURE_2D_ARRAY, weightArray_);
         glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, internal, muW_, muH_, K, 0, GL_RGBA, type, nullptr);
@@ -93,6 +101,13 @@ Decompression::Decompression(const BakeData& d, const RefractorOptions& options,
             glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, k, muW_, muH_, 1, GL_RGBA, type, data);
         else
             weightTex_.push_back(makeTexture2D(internal, muW_, muH_, GL_RGBA, type, data, GL_NEAREST));
+    }
+    if (grid && limits_.unormWeights) {  // the dequantization as a K x 2 texture (shadergen.h)
+        std::vector<float> range(size_t(K) * 8);
+        std::copy(u8Scale_.begin(), u8Scale_.end(), range.begin());
+        std::copy(u8Offset_.begin(), u8Offset_.end(), range.begin() + size_t(K) * 4);
+        rangeTexture_ = makeTexture2D(GL_RGBA32F, K, 2, GL_RGBA, GL_FLOAT, range.data(), GL_NEAREST);
+        memory_.weights += range.size() * sizeof(float);
     }
     // The fold feeds the lobe; sharp shading draws none, so it neither uploads nor runs it.
     if (d.errorOrder >= 0 && options.errorModel && options.shading != Shading::Sharp) {
@@ -135,7 +150,7 @@ Decompression::~Decompression() {
     for (auto& [L, c] : compiled_)
         for (GLuint p : c.programs) glDeleteProgram(p);
     glDeleteProgram(smoothProgram_);
-    for (GLuint t : {weightArray_, rangeTex_, nbrIndexTex_, nbrWeightTex_})
+    for (GLuint t : {weightArray_, rangeTexture_, rangeTex_, nbrIndexTex_, nbrWeightTex_})
         if (t) glDeleteTextures(1, &t);
     if (!weightTex_.empty())
         glDeleteTextures(static_cast<GLsizei>(weightTex_.size()), weightTex_.data());
@@ -148,11 +163,12 @@ void Decompression::bindWeights(const DecompressionPass& pass, int firstUnit) co
     for (const SamplerBinding& s : pass.samplers) {
         if (s.kind == SamplerBinding::Weight) bindTexture(unit++, GL_TEXTURE_2D, weightTex_[s.coefficient]);
         if (s.kind == SamplerBinding::WeightArray) bindTexture(unit++, GL_TEXTURE_2D_ARRAY, weightArray_);
+        if (s.kind == SamplerBinding::WeightRange) bindTexture(unit++, GL_TEXTURE_2D, rangeTexture_);
     }
 }
 
 void Decompression::setWeightUniforms(GLuint program, int K) const {
-    if (weightFormat_ != WeightFormat::Unorm8) return;
+    if (weightFormat_ != WeightFormat::Unorm8 || bake_.basis == Basis::Grid) return;
     glUniform4fv(glGetUniformLocation(program, "uWeightScale"), K, u8Scale_.data());
     glUniform4fv(glGetUniformLocation(program, "uWeightOffset"), K, u8Offset_.data());
 }
@@ -161,7 +177,9 @@ const Decompression::Compiled& Decompression::compiled(int L) {
     auto it = compiled_.find(L);
     if (it != compiled_.end()) return it->second;
     Compiled c;
-    c.shaders = generateDecompression(L, limits_, form_);
+    c.shaders = bake_.basis == Basis::Grid
+                    ? generateGridDecompression(bake_.grid.nTheta, bake_.grid.nPhi, limits_)
+                    : generateDecompression(L, limits_, form_);
     const int K = shEvenCount(L);
     for (size_t i = 0; i < c.shaders.passes.size(); ++i) {
         const DecompressionPass& pass = c.shaders.passes[i];
@@ -230,6 +248,9 @@ GLuint Decompression::run(glm::vec3 eyeObject, int order, bool smoothing, const 
                     break;
                 case SamplerBinding::WeightArray:
                     bindTexture(unit, GL_TEXTURE_2D_ARRAY, weightArray_);
+                    break;
+                case SamplerBinding::WeightRange:
+                    bindTexture(unit, GL_TEXTURE_2D, rangeTexture_);
                     break;
             }
         }

@@ -65,6 +65,7 @@ private:
     std::vector<float> u8Scale_, u8Offset_;  // per coefficient, 4 each: code / 255 * scale + offset
     std::map<int, Compiled> compiled_;
     GLuint weightArray_ = 0;
+    GLuint rangeTexture_ = 0;  // the grid basis's u8 scale and offset (SamplerBinding::WeightRange)
     std::vector<GLuint> weightTex_;  // one per coefficient (the 2006 preset)
     GLuint rangeTex_ = 0, nbrIndexTex_ = 0, nbrWeightTex_ = 0;
     GLuint smoothProgram_ = 0, emptyVao_ = 0;

@@ -90,7 +90,8 @@ GLuint DirectPipeline::vertexProgram(int order) {
     // Units 0 and 1 are the environment and (unused here) D; weights from unit 4 on.
     int unit = 4;
     for (const SamplerBinding& s : pass.samplers)
-        if (s.kind == SamplerBinding::Weight || s.kind == SamplerBinding::WeightArray)
+        if (s.kind == SamplerBinding::Weight || s.kind == SamplerBinding::WeightArray ||
+            s.kind == SamplerBinding::WeightRange)
             glUniform1i(glGetUniformLocation(p, s.name.c_str()), unit++);
     decompression_.setWeightUniforms(p, shEvenCount(order));
     glUseProgram(0);

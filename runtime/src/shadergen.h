@@ -78,7 +78,9 @@ ShForm resolveShForm(ShForm form, int order);
 
 // What a sampler uniform of a pass binds.
 struct SamplerBinding {
-    enum Kind { LocalView, PartialSum, Weight, WeightArray } kind;
+    // WeightRange: the grid basis's 8-bit dequantization, texel (k, 0) the scale and (k, 1) the
+    // offset of layer k (a texture: a 16x32 grid's 512 layers outgrow the uniform arrays).
+    enum Kind { LocalView, PartialSum, Weight, WeightArray, WeightRange } kind;
     int coefficient = -1;  // even index k for Weight
     std::string name;      // the GLSL uniform
 };
@@ -97,6 +99,7 @@ struct DecompressionPass {
 
 struct DecompressionShaders {
     int order = 0;
+    int gridTheta = 0, gridPhi = 0;  // the grid basis (generateGridDecompression); 0: SH
     ShaderLimits limits;
     ShForm form = ShForm::Polynomial;  // the form generated (never Auto)
     std::string vertex;  // full-screen triangle from gl_VertexID
@@ -114,6 +117,12 @@ struct DecompressionShaders {
 // 16: y_L^L alone needs the powers (x + iy)^2..L, 4 (L - 1) + 3 > 64 ALU).
 DecompressionShaders generateDecompression(int order, const ShaderLimits& limits,
                                            ShForm form = ShForm::Auto);
+
+// The grid basis (BakeData::basis Grid): one pass whose shPass fetches the four weight layers
+// around w (shaders/grid_eval.glsl) and blends them: 4 fetches whatever the grid. Needs
+// limits.weightArray (std::invalid_argument otherwise: the "2006" preset's one texture per
+// coefficient cannot reach 512 layers).
+DecompressionShaders generateGridDecompression(int nTheta, int nPhi, const ShaderLimits& limits);
 
 // Writes decompress.vert, decompress_passN.frag and passes.txt into `dir` (created); throws
 // std::runtime_error naming the file on failure.

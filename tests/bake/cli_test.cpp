@@ -93,7 +93,11 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"fitgrid", "tetra.off", kTetra, "--order 16 --grid 8x16", "--order 16 stores 153 coefficients, more than the 128 directions"},
         BadCase{"budgettarget", "tetra.off", kTetra, "--budget 1 --target-error 5", "--target-error"},
         BadCase{"budgetcharts", "tetra.off", kTetra, "--budget 1 --layout isolated", "--budget searches joining layouts only"},
-        BadCase{"budgetshard", "tetra.off", kTetra, "--budget 1 --shard 0/2", "--budget cannot be combined with --shard"}),
+        BadCase{"budgetshard", "tetra.off", kTetra, "--budget 1 --shard 0/2", "--budget cannot be combined with --shard"},
+        BadCase{"basis", "tetra.off", kTetra, "--basis table", "--basis"},
+        BadCase{"gridorder", "tetra.off", kTetra, "--basis grid --order 8", "--order shapes an SH fit"},
+        BadCase{"gridbudget", "tetra.off", kTetra, "--basis grid --budget 1", "search SH models"},
+        BadCase{"gridsize", "tetra.off", kTetra, "--basis grid --grid 32x128", "more than the 2048"}),
     [](const auto& info) { return std::string(info.param.name); });
 
 // The chart layouts bake the test objects and say what they made.

@@ -29,7 +29,12 @@ const std::string kMerge = SHREFRACT_MERGE_EXE;
 const std::string kCow = std::string(SHREFRACT_DATA_DIR) + "/meshes/cow.off";
 // cow: 2904 samples at rate 1 = 91 batches of 32, so 4 and 7 slices are uneven; a coarse grid
 // and a low order keep every bake well under a second.
-const std::string kArgs = " --rate 1 --grid 8x16 --order 3 --cache '' -q --checkpoints 1";
+const std::string kArgs = " --rate 1 --grid 8x16 --cache '' -q --checkpoints 1";
+// A case's bake options: kArgs, order 3 unless the case stores the grid basis (which refuses
+// --order), and the case's own.
+std::string argsWith(const std::string& options) {
+    return kArgs + (options.find("--basis grid") == std::string::npos ? " --order 3" : "") + options;
+}
 
 void expectSameBake(const std::string& a, const std::string& b) {
     EXPECT_EQ(test::bakeDifference(readBake(a), readBake(b)), "") << a << " and " << b;
@@ -50,7 +55,7 @@ std::string reference(const std::string& options) {
         if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
     const std::string out = tmp("shard_ref" + name + "_" + std::to_string(::getpid()) + ".shrefract.exr");
     if (made.paths.insert(out).second) {
-        CommandResult r = run(kBake + " " + kCow + " -o " + out + kArgs + options);
+        CommandResult r = run(kBake + " " + kCow + " -o " + out + argsWith(options));
         EXPECT_EQ(r.code, 0) << r.out;
     }
     return out;
@@ -64,8 +69,8 @@ std::vector<std::string> bakeShards(const std::string& name, int n, const std::s
         const std::string s = tmp(name + "_" + std::to_string(i) + "_of_" + std::to_string(n) + ".exr");
         const std::string input = i == 0 ? "cd " + fs::path(kCow).parent_path().string() + " && " + kBake + " cow.off"
                                          : kBake + " " + kCow;
-        CommandResult r = run(input + " -o " + s + kArgs + " --shard " +
-                              std::to_string(i) + "/" + std::to_string(n) + extra);
+        CommandResult r = run(input + " -o " + s + argsWith(extra) + " --shard " +
+                              std::to_string(i) + "/" + std::to_string(n));
         EXPECT_EQ(r.code, 0) << r.out;
         shards.push_back(s);
     }
@@ -120,25 +125,26 @@ TEST_P(MergedShards, EqualTheSingleMachineBake) {
 }
 
 // N = 1, 4, 7 (91 batches: uneven slices); 8-bit weights, quantized over the whole bake by the
-// merge; the weighted fit, which solves per sample; the scalar tracer.
+// merge; the weighted fit, which solves per sample; the scalar tracer; the grid basis.
 INSTANTIATE_TEST_SUITE_P(Counts, MergedShards,
                          ::testing::Values(MergeCase{"1", 1, ""}, MergeCase{"4", 4, ""},
                                            MergeCase{"7", 7, ""},
                                            MergeCase{"4_u8", 4, " --precision u8"},
                                            MergeCase{"3_weighted", 3, " --fit weighted"},
-                                           MergeCase{"2_scalar", 2, " --tracer scalar"}),
+                                           MergeCase{"2_scalar", 2, " --tracer scalar"},
+                                           MergeCase{"3_grid", 3, " --basis grid"}),
                          [](const auto& info) { return std::string(info.param.name); });
 
 // With --shard N alone, the index comes from SLURM_ARRAY_TASK_ID: the same shard as --shard I/N.
 TEST(Shard, SlurmArrayTaskIdGivesTheIndex) {
     const std::string a = tmp("slurm_task_a.exr"), b = tmp("slurm_task_b.exr");
-    ASSERT_EQ(run(kBake + " " + kCow + " -o " + a + kArgs + " --shard 2/3").code, 0);
-    CommandResult r = run("SLURM_ARRAY_TASK_ID=2 " + kBake + " " + kCow + " -o " + b + kArgs + " --shard 3");
+    ASSERT_EQ(run(kBake + " " + kCow + " -o " + a + argsWith("") + " --shard 2/3").code, 0);
+    CommandResult r = run("SLURM_ARRAY_TASK_ID=2 " + kBake + " " + kCow + " -o " + b + argsWith("") + " --shard 3");
     ASSERT_EQ(r.code, 0) << r.out;
     const ShardData x = readShard(a), y = readShard(b);
     EXPECT_EQ(x.manifest["shard"], y.manifest["shard"]);
     EXPECT_EQ(x.weights, y.weights);
-    r = run("env -u SLURM_ARRAY_TASK_ID " + kBake + " " + kCow + " -o " + b + kArgs + " --shard 3");
+    r = run("env -u SLURM_ARRAY_TASK_ID " + kBake + " " + kCow + " -o " + b + argsWith("") + " --shard 3");
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.out.find("SLURM_ARRAY_TASK_ID"), std::string::npos) << r.out;
 }
@@ -154,7 +160,7 @@ class ShardRejects : public ::testing::TestWithParam<BadShardArgs> {};
 TEST_P(ShardRejects, BadSlicesWithAClearError) {
     const std::string out = tmp(std::string("badslice_") + GetParam().name + ".exr");
     fs::remove(out);
-    CommandResult r = run("SLURM_ARRAY_TASK_ID=9 " + kBake + " " + kCow + " -o " + out + kArgs + " " + GetParam().args);
+    CommandResult r = run("SLURM_ARRAY_TASK_ID=9 " + kBake + " " + kCow + " -o " + out + argsWith("") + " " + GetParam().args);
     EXPECT_EQ(r.code, 2) << r.out;
     EXPECT_NE(r.out.find(GetParam().expect), std::string::npos) << r.out;
     EXPECT_FALSE(fs::exists(out));

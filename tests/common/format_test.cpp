@@ -24,6 +24,7 @@
 
 #include "common/bakefile.h"
 #include "common/checksum.h"
+#include "common/decompress.h"
 #include "common/error.h"
 #include "common/sh.h"
 #include "support/files.h"
@@ -233,6 +234,36 @@ TEST(Format, RoundTripF32IsExact) {
     EXPECT_TRUE(r.u8Scale.empty());
     EXPECT_TRUE(r.u8Offset.empty());
     EXPECT_TRUE(leftovers(path.parent_path()).empty());
+}
+
+// Version 4's grid basis (docs/format.md "weights"): one coefficient per grid direction, the grid
+// in the manifest, order 0; it reads back as written, and the CPU decompressor at a grid
+// direction returns that direction's weights (a node of the bilinear interpolation).
+TEST(Format, GridBasisRoundTrips) {
+    const fs::path path = scratch() / "grid.shrefract.exr";
+    BakeData d = syntheticBake(Precision::F32);
+    d.basis = Basis::Grid;
+    d.order = 0;
+    d.grid = DirectionGrid{4, 8};
+    const size_t n = d.layout.position.size();
+    d.weights.resize(32 * n * 4);
+    for (size_t v = 0; v < d.weights.size(); ++v) d.weights[v] = float(v % 1009) / 1009.0f;
+    writeBake(path.string(), d);
+    const BakeData r = readBake(path.string());
+    EXPECT_EQ(r.basis, Basis::Grid);
+    EXPECT_EQ(r.grid.ToString(), "4x8");
+    EXPECT_EQ(r.coefficientCount(), 32);
+    EXPECT_EQ(r.manifest.value("basis", ""), "grid");
+    ASSERT_EQ(r.weights, d.weights);
+    for (int j = 0; j < 32; ++j) {
+        const glm::vec4 got = decompressSample(r, 5, glm::vec3(r.grid.direction(j)));
+        const float* want = &d.weights[(size_t(j) * n + 5) * 4];
+        for (int c = 0; c < 4; ++c) EXPECT_NEAR(got[c], want[c], 1e-5f) << "direction " << j;
+    }
+    // An SH bake has no "basis" key, as every file before version 4.
+    const fs::path sh = scratch() / "sh_basis.shrefract.exr";
+    writeBake(sh.string(), syntheticBake(Precision::F32));
+    EXPECT_FALSE(readBake(sh.string()).manifest.contains("basis"));
 }
 
 // Version 3's error model (docs/format.md "error"): stored as float, whatever the weights'
@@ -624,6 +655,12 @@ TEST(Format, ManifestValuesAreValidatedLikeTheBakeOptions) {
         {[](json& m) { m["branch"] = "reflect"; }, "\"branch\" \"reflect\""},
         {[](json& m) { m["order"] = 25, m["coefficients"] = 351; }, "SH order 25 is not in [0, 20]"},
         {[](json& m) { m["rate"] = 65; }, "rate 65 is not in [1, 64]"},
+        {[](json& m) { m["basis"] = "table"; }, "basis"},
+        {[](json& m) { m["basis"] = "grid"; }, "a grid-basis bake has SH order 0, not 4"},
+        {[](json& m) { m["basis"] = "grid", m["order"] = 0; }, "manifest has no \"grid\" array"},
+        {[](json& m) { m["basis"] = "grid", m["order"] = 0, m["grid"] = {32, 64}; }, "15 coefficients, grid 32x64 has 2048"},
+        {[](json& m) { m["basis"] = "grid", m["order"] = 0, m["grid"] = {64, 64}; },
+         "stores 4096 coefficients per sample, more than 2048"},
         {[](json& m) { m["sampleCount"] = 4294967296ll; }, "manifest has no integer \"sampleCount\""},
         {[](json& m) { m["mu"] = {40000, 1}; }, "above 32768"},
         // The list would be read past its part's pixels.

@@ -61,6 +61,32 @@ TEST(ShaderGen, TooSmallLimitsAreRefused) {
     tiny.maxAluInstructions = 3;
     EXPECT_THROW(generateDecompression(4, tiny), std::invalid_argument);
     EXPECT_THROW(parseName<ShaderPreset>("2042"), std::invalid_argument);
+    // The grid basis needs all its layers in one array: the 2006 preset has a texture each.
+    EXPECT_THROW(generateGridDecompression(8, 16, shaderPreset(ShaderPreset::Paper2006)), std::invalid_argument);
+}
+
+// The grid basis's one pass compiles as GLSL 3.30 core and 4.50, float and 8-bit weights.
+TEST(ShaderGen, GridBasisGlslCompiles) {
+    if (std::string(SHREFRACT_GLSLANG).empty() || !std::filesystem::exists(SHREFRACT_GLSLANG))
+        GTEST_SKIP() << "glslangValidator not found (Debian: glslang-tools)";
+    namespace fs = std::filesystem;
+    for (const char* version : {"330 core", "450"})
+        for (bool unorm : {false, true}) {
+            ShaderLimits limits = shaderPreset(ShaderPreset::Modern);
+            limits.version = version;
+            limits.unormWeights = unorm;
+            const DecompressionShaders s = generateGridDecompression(16, 32, limits);
+            ASSERT_EQ(s.passes.size(), 1u);
+            EXPECT_EQ(s.summary(), "grid 16x32, limits modern: 1 pass");
+            const fs::path sub = fs::path(SHREFRACT_TEST_TMP) / "glsl" /
+                                 ("grid_" + std::string(version).substr(0, 3) + (unorm ? "_u8" : "_f32"));
+            dumpShaders(s, sub.string());
+            for (const char* name : {"decompress.vert", "decompress_pass1.frag"}) {
+                const std::string f = (sub / name).string();
+                const std::string cmd = std::string(SHREFRACT_GLSLANG) + " " + f + " > " + f + ".log 2>&1";
+                EXPECT_EQ(std::system(cmd.c_str()), 0) << f << "\n" << readFile(f + ".log");
+            }
+        }
 }
 
 // Compiles every generated pass with glslangValidator as GLSL 3.30 core and 4.50.

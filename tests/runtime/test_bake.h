@@ -42,14 +42,37 @@ inline BakeData randomBake(SurfaceLayout layout, int order, unsigned seed = 7) {
     return d;
 }
 
-// The octahedron's joining layout at `rate`, random weights.
-inline BakeData randomBake(int order, int rate, unsigned seed = 7) {
+// The octahedron's joining layout at `rate`.
+inline SurfaceLayout octahedronLayout(int rate) {
     Scene scene;
     Part part;
     part.name = "octahedron";
     part.mesh = octahedron();
     scene.parts.push_back(part);
-    return randomBake(buildJoiningLayout(scene, rate), order, seed);
+    return buildJoiningLayout(scene, rate);
+}
+
+// The octahedron's joining layout at `rate`, random weights.
+inline BakeData randomBake(int order, int rate, unsigned seed = 7) {
+    return randomBake(octahedronLayout(rate), order, seed);
+}
+
+// A grid-basis bake (BakeData::basis Grid) of the octahedron at `rate`: every sample's exit at
+// every direction of `grid` random, x, y, z in [-1, 1] around +z and the length in [0, 2].
+inline BakeData randomGridBake(DirectionGrid grid, int rate, unsigned seed = 7) {
+    BakeData d;
+    d.basis = Basis::Grid;
+    d.order = 0;
+    d.grid = grid;
+    d.layout = octahedronLayout(rate);
+    d.manifest = {{"media", {{{"name", "glass"}, {"ior", 1.5}, {"absorption", {0.1, 0.2, 0.3}}}}}};
+    const size_t n = d.layout.position.size();
+    d.weights.resize(size_t(grid.count()) * n * 4);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    for (float& w : d.weights) w = u(rng);
+    for (size_t t = 0; t < size_t(grid.count()) * n; ++t) d.weights[t * 4 + 2] += 2.0f, d.weights[t * 4 + 3] += 1.0f;
+    return d;
 }
 
 }  // namespace shrefract::test

@@ -166,7 +166,7 @@ struct BakeData {
     // and path length.
     std::vector<float> weights;
     // For U8 only: per coefficient k and channel c, value = scale * code + offset.
-    std::vector<float> u8Scale, u8Offset;  // shEvenCount(order) * 4 each
+    std::vector<float> u8Scale, u8Offset;  // coefficientCount() * 4 each
 
     // The bake's model of its own angular error (docs/format.md "error"): per sample the even SH
     // through errorOrder of ln(angle + kErrorOffset), the angle in radians between the fitted and
@@ -175,6 +175,8 @@ struct BakeData {
     std::vector<float> errors;
 
     int coefficientCount() const;  // basisCoefficients(basis, order, grid)
+    // What the tools print for the model: "order 12", or "grid basis 16x32".
+    std::string modelName() const;
     int errorCoefficientCount() const;  // shEvenCount(errorOrder), 0 without a model
 
     // Not stored: what readBake noticed that the caller should tell the user (e.g. a version 1

@@ -17,6 +17,9 @@ int basisCoefficients(Basis basis, int order, const DirectionGrid& grid) {
     return basis == Basis::Grid ? grid.count() : shEvenCount(order);
 }
 int BakeData::coefficientCount() const { return basisCoefficients(basis, order, grid); }
+std::string BakeData::modelName() const {
+    return basis == Basis::Grid ? "grid basis " + grid.ToString() : "order " + std::to_string(order);
+}
 int BakeData::errorCoefficientCount() const { return errorOrder < 0 ? 0 : shEvenCount(errorOrder); }
 
 namespace format_internal {

@@ -161,7 +161,7 @@ nlohmann::json evaluateDirections(const BakeData& bake, const Scene& scene, size
     return {{"pairs", pairs},
             {"seed", seed},
             {"order", order < 0 ? bake.order : std::min(order, bake.order)},
-            {"basis", bake.basis == Basis::Grid ? "grid " + bake.grid.ToString() : "sh"},
+            {"model", order < 0 || order >= bake.order ? bake.modelName() : "order " + std::to_string(order)},
             {"angleDeg", all["angleDeg"]},
             {"lengthError", all["lengthError"]},
             {"all", all},

@@ -108,11 +108,10 @@ void RenderMethod::Impl::setUpSh(const Camera& camera, nlohmann::json& summary) 
                     bake.ior(), bracket ? " and the bracketing bake's" : " and the straight path");
     }
     const bool joining = bake.layout() == "joining";
-    const std::string stored = bake.basis() == "sh" ? "order " + std::to_string(bake.order()) : bake.basis() + " basis";
     std::printf("bake: %s, %d samples, %d triangles, %s layout, %s %dx%d; using "
                 "order %d, %d decompression pass(es), preset %s, path %s, decompression %s, "
                 "shading %s; GPU memory %.2f MB\n",
-                stored.c_str(), bake.sampleCount(), bake.triangleCount(), bake.layout().c_str(),
+                bakeData(bake).modelName().c_str(), bake.sampleCount(), bake.triangleCount(), bake.layout().c_str(),
                 joining ? "rho" : "atlas", refractor->refractionMapSize().x,
                 refractor->refractionMapSize().y, refractor->order(), refractor->passCount(),
                 nameOf(options.preset), nameOf(refractor->path()), nameOf(refractor->decompression()),

@@ -347,9 +347,7 @@ int main(int argc, char** argv) {
                         pct(s.tir), pct(s.capped), pct(s.softCapped), pct(s.reentered), pct(s.geometricNormal),
                         pct(s.leaked));
             std::printf("  file        %.1f MB, %s, %d coefficients, %s\n",
-                        std::filesystem::file_size(output) / 1e6,
-                        opt.basis == Basis::Grid ? ("grid basis " + opt.grid.ToString()).c_str()
-                                                 : ("order " + std::to_string(opt.order)).c_str(),
+                        std::filesystem::file_size(output) / 1e6, res.data.modelName().c_str(),
                         res.data.coefficientCount(), nameOf(opt.precision));
             return int(cli::kOk);
         } catch (const Cancelled&) {

@@ -44,9 +44,8 @@ void printTable(const nlohmann::json& r) {
                         c["ceiling"]["lengthError"]["mean"].get<double>());
         std::printf("\n");
     };
-    const std::string basis = r.value("basis", "sh");
     std::printf("direction error, degrees (%zu pairs, %s)%s\n", r["pairs"].get<size_t>(),
-                basis == "sh" ? ("order " + std::to_string(r["order"].get<int>())).c_str() : basis.c_str(),
+                r["model"].get<std::string>().c_str(),
                 ceiling ? "; right: the data ceiling, the raw grid interpolated bilinearly" : "");
     std::printf("  %-11s %7s  %8s %8s %8s %8s %8s   %8s", "paths", "share", "mean", "median", "p95",
                 "p99", "max", "len err");

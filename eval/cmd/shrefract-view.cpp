@@ -224,11 +224,10 @@ int main(int argc, char** argv) {
         glfwSetMouseButtonCallback(window, onMouseButton);
         glfwSetCursorPosCallback(window, onCursor);
         glfwSetScrollCallback(window, onScroll);
-        const std::string stored = bake.basis() == "sh" ? "order " + std::to_string(bake.order()) : bake.basis() + " basis";
         std::printf("bake: %s, %d samples, %d triangles, %s layout; %.1f MB of GPU textures\n"
                     "keys: drag orbit, scroll zoom, Up/Down order, S smoothing, M method, "
                     "T timings, G gutters, A seam-aware (charts), P/F12 screenshot, Esc quit\n",
-                    stored.c_str(), bake.sampleCount(), bake.triangleCount(), bake.layout().c_str(),
+                    bakeData(bake).modelName().c_str(), bake.sampleCount(), bake.triangleCount(), bake.layout().c_str(),
                     refractor->memory().total() / 1e6);
         const bool charts = bake.layout() != "joining";
 

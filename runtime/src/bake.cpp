@@ -16,10 +16,6 @@ Bake::Bake(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) { SHREFRAC
 const Bake::Impl& Bake::impl() const { return *impl_; }
 
 int Bake::order() const { return bakeData(*this).order; }
-std::string Bake::basis() const {
-    const BakeData& d = bakeData(*this);
-    return d.basis == Basis::Grid ? "grid " + d.grid.ToString() : "sh";
-}
 const std::vector<std::string>& Bake::warnings() const { return bakeData(*this).warnings; }
 
 std::vector<MapVertex> Bake::refractionMapMesh() const {

@@ -20,8 +20,7 @@ DirectPipeline::DirectPipeline(const PipelineInputs& in)
       decompression_(bakeData(in.bake), in.options, in.maxOrder, in.limits, in.form, grid_, in.memory) {
     const DecompressionSite site = in.options.decompression;
     // A single decompression pass (the modern preset) can run in the shading's vertex shader.
-    const bool onePass =
-        generateDecompression(settings_.order, decompression_.limits(), decompression_.form()).passes.size() == 1;
+    const bool onePass = decompression_.compiled(settings_.order).programs.size() == 1;
     if (site == DecompressionSite::Vertex && !onePass)
         throw std::invalid_argument("shrefract: vertex decompression needs a one-pass preset");
     vertexAllowed_ = onePass && site != DecompressionSite::Texture;

@@ -25,10 +25,7 @@ struct MapVertex {
 // A loaded bake, cheap to copy (shared, immutable).
 class Bake {
 public:
-    int order() const;          // L stored (0 for the grid basis)
-    // What the coefficients are: "sh", or "grid NTHETAxNPHI" for a bake that stores its traced
-    // grid itself (shrefract-bake --basis grid; docs/format.md "weights").
-    std::string basis() const;
+    int order() const;          // L stored (0 for a grid-basis bake: docs/format.md "weights")
     int sampleCount() const;    // |O_d|
     int triangleCount() const;
     // The surface layout: "joining" (paper §5.3: every triangle on a barycentric grid, seamless),

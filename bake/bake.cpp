@@ -62,21 +62,22 @@ struct BakePlan::Compression {
     std::unique_ptr<ResidualFitter> residual;  // the error model, when the bake stores one
     std::vector<glm::vec3> dirs;             // grid directions, local frame
     std::vector<uint32_t> order;             // the order they are traced in: packetOrder(grid)
+    std::vector<glm::vec3> checks;           // where the error model's truth is traced apart
+    std::vector<uint32_t> checkOrder;        // and the order they are traced in
 };
 
 BakePlan::BakePlan(const Scene& scene, const BakeOptions& opt, const std::string& inputPath)
     : scene_(scene), opt_(opt), input_(inputPath) {
     if (opt.basis == Basis::Grid) {
-        // The traced grid is the model: nothing to fit, and nothing missed at its directions.
+        // The traced grid is the model: nothing to fit, and nothing missed at its directions; its
+        // error model checks it between them (bake/residual.h).
         if (opt.grid.count() > limits::kMaxGridBasis)
             throw InputError(str("--basis grid stores every direction of --grid ", opt.grid.ToString(), " (",
                                  opt.grid.count(), "), more than the ", limits::kMaxGridBasis,
                                  " the runtime can hold per sample: use a coarser --grid"));
         opt_.order = 0;
-        opt_.errorOrder = -1;
-    } else {
-        opt_.errorOrder = storedErrorOrder(opt.errorOrder, opt.order, opt.grid);
     }
+    opt_.errorOrder = storedErrorOrder(opt.errorOrder, opt.basis, opt_.order, opt.grid);
     if (opt.basis == Basis::Sh && !fitCanSolve(opt.fit, opt.order, opt.grid))
         throw InputError(str("--order ", opt.order, " stores ", shEvenCount(opt.order), " coefficients, more than the ",
                              opt.grid.count(), " directions of --grid ", opt.grid.ToString(), ": the ",
@@ -105,10 +106,15 @@ void BakePlan::prepareTracing() const {
             c->fit = std::make_unique<SampleFit>(opt_.grid, opt_.order, opt_.fit, opt_.weighting,
                                                  opt_.filterWidth, opt_.cacheDir);
         if (opt_.errorOrder >= 0)
-            c->residual = std::make_unique<ResidualFitter>(opt_.grid, opt_.order, opt_.errorOrder);
+            c->residual = std::make_unique<ResidualFitter>(opt_.basis, opt_.grid, opt_.order, opt_.errorOrder);
         c->dirs.resize(J);
         for (int j = 0; j < J; ++j) c->dirs[j] = glm::vec3(opt_.grid.direction(j));
         c->order = packetOrder(opt_.grid.nTheta, opt_.grid.nPhi);
+        if (c->residual) {
+            c->checks = c->residual->checkDirections();
+            // The corners lie on a grid one ring short of the traced one: traced in its packet order.
+            if (!c->checks.empty()) c->checkOrder = packetOrder(opt_.grid.nTheta - 1, opt_.grid.nPhi);
+        }
         compression_ = std::move(c);
         tracer_ = std::make_unique<Tracer>(scene_, opt_.trace);
     });
@@ -148,46 +154,59 @@ SliceResult BakePlan::bakeSlice(size_t beginBatch, size_t endBatch, const SliceP
     std::mutex progressMutex;
     auto lastReport = Clock::now();
 
+    const std::vector<glm::vec3>& checks = compression.checks;
+    const int Jc = int(checks.size());
+
     tbb::parallel_for(tbb::blocked_range<size_t>(beginBatch, endBatch, 1), [&](const tbb::blocked_range<size_t>& range) {
         enableFlushToZero();
-        Eigen::MatrixXf R(J, 4 * kBakeBatch), Wt(4 * kBakeBatch, K), E(Ke, kBakeBatch);
-        std::vector<glm::vec3> omegas(J);
-        std::vector<PathResult> paths(J);
+        Eigen::MatrixXf R(J, 4 * kBakeBatch), C(Jc, 4 * kBakeBatch), Wt(4 * kBakeBatch, K), E(Ke, kBakeBatch);
+        std::vector<glm::vec3> omegas(std::max(J, Jc));
+        std::vector<PathResult> paths(std::max(J, Jc));
         std::vector<PathResult> batchPaths(weighted ? size_t(J) * kBakeBatch : 0);  // [s * J + j]
+        size_t localRays = 0, ntir = 0, ncap = 0, nsoft = 0, nre = 0, ngeo = 0, nleak = 0;
+        // Traces sample i toward `local` (traced in `packet` order) into M's columns 4s..4s+3:
+        // exit x, y, z and length, row j for direction j. Returns the paths, paths[q] direction
+        // packet[q]'s.
+        auto traceSample = [&](size_t i, size_t s, const std::vector<glm::vec3>& local,
+                               const std::vector<uint32_t>& packet, Eigen::MatrixXf& M) {
+            const int n = int(local.size());
+            const Frame frame = Frame::fromNormal(L.normal[i]);
+            for (int q = 0; q < n; ++q) omegas[q] = frame.fromLocal(local[packet[q]]);
+            if (opt.coherent) {
+                tracer.traceCoherent(L.position[i], L.normal[i], omegas.data(), n, L.part[i], paths.data());
+            } else {
+                for (int q = 0; q < n; ++q) paths[q] = tracer.trace(L.position[i], L.normal[i], omegas[q], L.part[i]);
+            }
+            for (int q = 0; q < n; ++q) {
+                const PathResult& p = paths[q];
+                const int j = int(packet[q]);
+                M(j, 4 * s + 0) = p.exit.x;
+                M(j, 4 * s + 1) = p.exit.y;
+                M(j, 4 * s + 2) = p.exit.z;
+                M(j, 4 * s + 3) = p.length;
+                localRays += p.rays;
+                ntir += (p.flags & kPathTIR) != 0;
+                ncap += (p.flags & kPathCapped) != 0;
+                nsoft += (p.flags & kPathSoftCapped) != 0;
+                nre += (p.flags & kPathReentered) != 0;
+                ngeo += (p.flags & kPathGeometricNormal) != 0;
+                nleak += (p.flags & kPathLeaked) != 0;
+            }
+        };
         for (size_t b = range.begin(); b != range.end(); ++b) {
             if (opt.cancel && opt.cancel->load()) return;
             const size_t batchFirst = b * kBakeBatch;
             const size_t batchCount = std::min<size_t>(kBakeBatch, n - batchFirst);
-            // 1. Trace the batch: R holds every sample's exits and lengths, one column each.
+            // 1. Trace the batch: R holds every sample's exits and lengths, one column each; C the
+            // same at the error model's own check directions, where it has them.
             auto tTrace = Clock::now();
-            size_t localRays = 0, ntir = 0, ncap = 0, nsoft = 0, nre = 0, ngeo = 0, nleak = 0;
+            localRays = ntir = ncap = nsoft = nre = ngeo = nleak = 0;
             R.setZero();
             for (size_t s = 0; s < batchCount; ++s) {
-                const size_t i = batchFirst + s;
-                const Frame frame = Frame::fromNormal(L.normal[i]);
-                // Directions in packet order: paths[q] is direction order[q]'s.
-                for (int q = 0; q < J; ++q) omegas[q] = frame.fromLocal(dirs[order[q]]);
-                if (opt.coherent) {
-                    tracer.traceCoherent(L.position[i], L.normal[i], omegas.data(), J, L.part[i], paths.data());
-                } else {
-                    for (int q = 0; q < J; ++q) paths[q] = tracer.trace(L.position[i], L.normal[i], omegas[q], L.part[i]);
-                }
-                for (int q = 0; q < J; ++q) {
-                    const PathResult& p = paths[q];
-                    const int j = int(order[q]);
-                    if (weighted) batchPaths[s * J + j] = p;
-                    R(j, 4 * s + 0) = p.exit.x;
-                    R(j, 4 * s + 1) = p.exit.y;
-                    R(j, 4 * s + 2) = p.exit.z;
-                    R(j, 4 * s + 3) = p.length;
-                    localRays += p.rays;
-                    ntir += (p.flags & kPathTIR) != 0;
-                    ncap += (p.flags & kPathCapped) != 0;
-                    nsoft += (p.flags & kPathSoftCapped) != 0;
-                    nre += (p.flags & kPathReentered) != 0;
-                    ngeo += (p.flags & kPathGeometricNormal) != 0;
-                    nleak += (p.flags & kPathLeaked) != 0;
-                }
+                traceSample(batchFirst + s, s, dirs, order, R);
+                if (weighted)
+                    for (int q = 0; q < J; ++q) batchPaths[s * J + order[q]] = paths[q];
+                if (Jc > 0) traceSample(batchFirst + s, s, checks, compression.checkOrder, C);
             }
             // 2. Compress the batch: the projection W = M R, one GEMM; or one weighted solve per
             // sample, the band filter applied to its weights.
@@ -196,12 +215,12 @@ SliceResult BakePlan::bakeSlice(size_t beginBatch, size_t endBatch, const SliceP
                 compression.fit->fit(R, weighted ? batchPaths.data() : nullptr, int(batchCount), Wt);
             else
                 Wt = R.transpose();  // the grid basis: weight j is the traced value at direction j
-            // 3. Store its weights, and the error model of what they miss at the grid directions.
+            // 3. Store its weights, and the error model of what they miss.
             for (int k = 0; k < K; ++k)
                 std::copy_n(Wt.col(k).data(), 4 * batchCount,
                             &out.weights[(size_t(k) * count + batchFirst - first) * 4]);
             if (Ke > 0) {
-                compression.residual->fit(R, Wt, int(batchCount), E);
+                compression.residual->fit(R, C, Wt, int(batchCount), E);
                 for (int k = 0; k < Ke; ++k)
                     for (size_t s = 0; s < batchCount; ++s)
                         out.errors[size_t(k) * count + batchFirst - first + s] = E(k, s);
@@ -226,7 +245,7 @@ SliceResult BakePlan::bakeSlice(size_t beginBatch, size_t endBatch, const SliceP
 
     BakeStats& st = out.stats;
     st.samples = count;
-    st.paths = count * size_t(J);
+    st.paths = count * size_t(J + Jc);
     st.rays = rays, st.tir = tir, st.capped = capped, st.softCapped = soft;
     st.reentered = reent, st.geometricNormal = geo, st.leaked = leaked;
     st.traceSeconds = traceNs * 1e-9, st.compressSeconds = compressNs * 1e-9;

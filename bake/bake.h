@@ -38,7 +38,8 @@ struct BakeProgress {
 
 struct BakeOptions {
     // Sh: fit each sample's grid with SH (the paper). Grid: store the traced grid itself, one
-    // coefficient per direction (docs/bake.md "The grid basis"): no fit, no error model, order 0.
+    // coefficient per direction (docs/bake.md "The grid basis"): no fit, order 0; its error model
+    // is traced apart, at the cells' corners (bake/residual.h).
     Basis basis = Basis::Sh;
     int order = 12;          // SH order L; 12 by the charts (docs/bake.md), the paper's is 8
     LayoutKind layout = LayoutKind::Joining;

@@ -4,23 +4,40 @@
 #include <cmath>
 #include <vector>
 
-#include <glm/glm.hpp>
-
-#include "common/bakefile.h"
 #include "common/error.h"
 #include "common/sh.h"
 
 namespace shrefract {
 
-int storedErrorOrder(int requested, int order, const DirectionGrid& grid) {
+int storedErrorOrder(int requested, Basis basis, int order, const DirectionGrid& grid) {
     if (requested < 0) return -1;
-    int e = std::min(requested, order);
-    while (e > 0 && shEvenCount(e) > grid.count()) --e;
+    const int checks = basis == Basis::Grid ? int(cellCorners(grid).directions.size()) : grid.count();
+    int e = basis == Basis::Grid ? requested : std::min(requested, order);
+    while (e >= 0 && shEvenCount(e) > checks) --e;
     return e;
 }
 
-ResidualFitter::ResidualFitter(const DirectionGrid& grid, int order, int errorOrder) {
-    SHREFRACT_CHECK(errorOrder >= 0 && shEvenCount(errorOrder) <= grid.count());
+ResidualFitter::ResidualFitter(Basis basis, const DirectionGrid& grid, int order, int errorOrder)
+    : basis_(basis) {
+    SHREFRACT_CHECK(errorOrder >= 0);
+    if (basis == Basis::Grid) {
+        const CellCorners corners = cellCorners(grid);
+        const int n = int(corners.directions.size());
+        SHREFRACT_CHECK(shEvenCount(errorOrder) <= n);
+        std::vector<Eigen::Triplet<float>> entries;
+        for (int c = 0; c < n; ++c) {
+            int index[4];
+            double weight[4];
+            const int count = grid.interpolate(corners.directions[c], index, weight);
+            for (int t = 0; t < count; ++t) entries.emplace_back(c, index[t], float(weight[t]));
+            check_.push_back(glm::vec3(corners.directions[c]));
+        }
+        read_.resize(n, grid.count());
+        read_.setFromTriplets(entries.begin(), entries.end());  // sums a corner's repeated indices
+        P_ = leastSquaresMatrix(corners.directions, corners.solidAngle, errorOrder).cast<float>();
+        return;
+    }
+    SHREFRACT_CHECK(shEvenCount(errorOrder) <= grid.count());
     const int J = grid.count(), K = shEvenCount(order);
     Y_.resize(J, K);
     std::vector<float> y(K);
@@ -31,19 +48,22 @@ ResidualFitter::ResidualFitter(const DirectionGrid& grid, int order, int errorOr
     P_ = leastSquaresMatrix(grid, errorOrder).cast<float>();
 }
 
-void ResidualFitter::fit(const Eigen::Ref<const Eigen::MatrixXf>& R,
-                         const Eigen::Ref<const Eigen::MatrixXf>& Wt, int B,
-                         Eigen::Ref<Eigen::MatrixXf> E) const {
-    const int J = int(Y_.rows());
-    SHREFRACT_CHECK(R.rows() == J && R.cols() >= 4 * B && Wt.rows() >= 4 * B &&
-                    Wt.cols() == Y_.cols() && E.rows() == P_.rows() && E.cols() >= B);
-    // The fitted mapping at every grid direction, all B samples in one GEMM: J x 4B.
-    const Eigen::MatrixXf fitted = Y_ * Wt.topRows(4 * B).transpose();
+void ResidualFitter::fit(const Eigen::Ref<const Eigen::MatrixXf>& R, const Eigen::Ref<const Eigen::MatrixXf>& C,
+                         const Eigen::Ref<const Eigen::MatrixXf>& Wt, int B, Eigen::Ref<Eigen::MatrixXf> E) const {
+    const bool grid = basis_ == Basis::Grid;
+    // The truth at the check directions, and the stored model's prediction there, all B samples
+    // in one product: checks x 4B.
+    const Eigen::Ref<const Eigen::MatrixXf>& truth = grid ? C : R;
+    const int J = int(P_.cols());
+    SHREFRACT_CHECK(truth.rows() == J && truth.cols() >= 4 * B && Wt.rows() >= 4 * B &&
+                    E.rows() == P_.rows() && E.cols() >= B);
+    const Eigen::MatrixXf predicted = grid ? Eigen::MatrixXf(read_ * Wt.topRows(4 * B).transpose())
+                                           : Eigen::MatrixXf(Y_ * Wt.topRows(4 * B).transpose());
     Eigen::MatrixXf angles(J, B);
     for (int s = 0; s < B; ++s)
         for (int j = 0; j < J; ++j) {
-            const glm::vec3 f(fitted(j, 4 * s), fitted(j, 4 * s + 1), fitted(j, 4 * s + 2));
-            const glm::vec3 r(R(j, 4 * s), R(j, 4 * s + 1), R(j, 4 * s + 2));
+            const glm::vec3 f(predicted(j, 4 * s), predicted(j, 4 * s + 1), predicted(j, 4 * s + 2));
+            const glm::vec3 r(truth(j, 4 * s), truth(j, 4 * s + 1), truth(j, 4 * s + 2));
             const float lf = glm::length(f), lr = glm::length(r);
             // No direction on either side: as far off as a random guess on the hemisphere.
             const float c = lf > 0 && lr > 0 ? glm::dot(f, r) / (lf * lr) : 0.0f;

@@ -79,9 +79,8 @@ std::string inconsistency(const BakeData& d) {
     if (d.basis == Basis::Grid && d.grid.count() > limits::kMaxGridBasis)
         return str("a grid-basis bake of ", d.grid.ToString(), " has more than ",
                    limits::kMaxGridBasis, " directions");
-    if (d.basis == Basis::Grid && (d.order != 0 || d.errorOrder >= 0))
-        return str("a grid-basis bake has SH order 0 and no error model, not order ", d.order,
-                   " and error model ", d.errorOrder);
+    if (d.basis == Basis::Grid && d.order != 0)
+        return str("a grid-basis bake has SH order 0, not ", d.order);
     const size_t K = size_t(d.coefficientCount());
     const size_t N = L.position.size();
     if (L.normal.size() != N || L.part.size() != N)

@@ -326,22 +326,44 @@ Eigen::MatrixXd compressionMatrix(const DirectionGrid& grid, int L, int q) {
 
 Eigen::MatrixXd leastSquaresMatrix(const DirectionGrid& grid, int L) {
     checkGrid(grid);
-    const int K = shEvenCount(L), J = grid.count();
-    SHREFRACT_CHECK(J >= K);
-    // Minimize sum_j a_j (sum_i c_i y_i(w_j) - r_j)^2 with a_j = cell solid angle:
+    std::vector<glm::dvec3> dirs(grid.count());
+    std::vector<double> a(grid.count());
+    for (int j = 0; j < grid.count(); ++j) dirs[j] = grid.direction(j), a[j] = cellSolidAngle(grid, j / grid.nPhi);
+    return leastSquaresMatrix(dirs, a, L);
+}
+
+Eigen::MatrixXd leastSquaresMatrix(const std::vector<glm::dvec3>& dirs, const std::vector<double>& solidAngle, int L) {
+    const int K = shEvenCount(L), J = int(dirs.size());
+    SHREFRACT_CHECK(J >= K && solidAngle.size() == dirs.size());
+    // Minimize sum_j a_j (sum_i c_i y_i(w_j) - r_j)^2 with a_j = the solid angle w_j stands for:
     // c = (Y^T A Y)^-1 Y^T A r. Even functions on the hemisphere keep the normal matrix near I/2.
     Eigen::MatrixXd Y(J, K);
-    Eigen::VectorXd a(J);
     std::vector<double> all(shCount(L));
     const std::vector<ShLM> fs = shEvenFunctions(L);
     for (int j = 0; j < J; ++j) {
-        shEvalAllRecurrence(L, grid.direction(j), all.data());
+        shEvalAllRecurrence(L, dirs[j], all.data());
         for (int e = 0; e < K; ++e) Y(j, e) = all[shIndex(fs[e].l, fs[e].m)];
-        a(j) = cellSolidAngle(grid, j / grid.nPhi);
     }
+    const Eigen::Map<const Eigen::VectorXd> a(solidAngle.data(), J);
     Eigen::MatrixXd YtA = Y.transpose() * a.asDiagonal();
     Eigen::MatrixXd G = YtA * Y;
     return G.ldlt().solve(YtA);
+}
+
+CellCorners cellCorners(const DirectionGrid& grid) {
+    checkGrid(grid);
+    const double dTheta = 0.5 * kPi / grid.nTheta, dPhi = 2.0 * kPi / grid.nPhi;
+    CellCorners c;
+    for (int i = 0; i + 1 < grid.nTheta; ++i) {
+        const double t = (i + 1) * dTheta;
+        const double area = dPhi * (std::cos(t - 0.5 * dTheta) - std::cos(t + 0.5 * dTheta));
+        for (int k = 0; k < grid.nPhi; ++k) {
+            const double p = (k + 1) * dPhi;
+            c.directions.push_back({std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)});
+            c.solidAngle.push_back(area);
+        }
+    }
+    return c;
 }
 
 Eigen::MatrixXd compressionMatrixCached(const DirectionGrid& grid, int L,

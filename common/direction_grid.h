@@ -44,6 +44,18 @@ Eigen::MatrixXd compressionMatrix(const DirectionGrid& grid, int L, int q = 8);
 // Least-squares alternative: K x J pseudo-inverse of the basis sampled at the grid directions
 // (weighted by cell solid angle), for the projection-vs-fit comparison.
 Eigen::MatrixXd leastSquaresMatrix(const DirectionGrid& grid, int L);
+// The same over any directions, each weighted by the solid angle it stands for: K x dirs.size().
+Eigen::MatrixXd leastSquaresMatrix(const std::vector<glm::dvec3>& dirs, const std::vector<double>& solidAngle, int L);
+
+// The directions furthest from the grid's own: the corners of its interpolation cells inside the
+// hemisphere, theta = (i + 1) (pi/2) / nTheta for i < nTheta - 1 and phi = (k + 1) 2pi / nPhi,
+// corner c = i * nPhi + k, each standing for the solid angle of the cell around it. Where a bilinear
+// read of the grid is least certain; none when nTheta is 1.
+struct CellCorners {
+    std::vector<glm::dvec3> directions;
+    std::vector<double> solidAngle;
+};
+CellCorners cellCorners(const DirectionGrid& grid);
 // compressionMatrix(), cached on disk in `cacheDir` under a name made of its parameters.
 // A corrupt or mismatched cache file is recomputed and rewritten. Empty cacheDir: no cache.
 Eigen::MatrixXd compressionMatrixCached(const DirectionGrid& grid, int L, const std::string& cacheDir);

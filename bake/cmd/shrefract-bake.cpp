@@ -85,8 +85,9 @@ int main(int argc, char** argv) {
                    "--fit weighted: FLAGGED:DEG:DISAGREEING:TRIMDEG:TRIMMED:PASSES (bake/fit.h)")
         ->capture_default_str();
     app.add_option("--error-order", opt.errorOrder,
-                   "SH order of the stored error model, the fit's angular error over the view "
-                   "directions (docs/bake.md \"Error model\"; -1: none)")
+                   "SH order of the stored error model, the stored model's angular error over the "
+                   "view directions (docs/bake.md \"Error model\"; -1: none; with --basis grid it "
+                   "traces the cells' corners too)")
         ->capture_default_str()->check(CLI::Range(-1, limits::kMaxErrorOrder));
     app.add_option("--precision", precision, "weight storage: f32, f16 or u8")->capture_default_str()
         ->check(CLI::IsMember({"f32", "f16", "u8"}));
@@ -132,7 +133,7 @@ int main(int argc, char** argv) {
             opt.layout = parseName<LayoutKind>(layout);
             opt.basis = parseName<Basis>(basis);
             if (opt.basis == Basis::Grid) {
-                for (const char* o : {"--order", "--fit", "--fit-weighting", "--filter", "--error-order"})
+                for (const char* o : {"--order", "--fit", "--fit-weighting", "--filter"})
                     if (app.count(o) > 0)
                         throw InputError(str(o, " shapes an SH fit; --basis grid stores the traced grid unfitted"));
                 if (targetError > 0 || budgetMB > 0)

@@ -42,6 +42,8 @@ public:
     GLuint result() const { return result_; }
     GLuint localViewTexture() const { return localView_.texture; }
     bool canSmooth() const { return rangeTex_ != 0; }
+    // The bake's error model is folded into D_mu (ErrorFold): only in texture space.
+    bool foldsError() const { return errorFold_ != nullptr; }
 
     // Binds the weight samplers of `pass` from texture unit `firstUnit` on, in the pass's order.
     void bindWeights(const DecompressionPass& pass, int firstUnit) const;

@@ -51,7 +51,7 @@ DirectPipeline::~DirectPipeline() {
 
 bool DirectPipeline::vertexMode() const {
     return vertexAllowed_ && !settings_.smoothing &&
-           (vertexRequired_ || settings_.order <= kAutoVertexMaxOrder);
+           (vertexRequired_ || (settings_.order <= kAutoVertexMaxOrder && !decompression_.foldsError()));
 }
 
 void DirectPipeline::prepare() {

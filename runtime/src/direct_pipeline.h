@@ -43,7 +43,8 @@ private:
     // "auto" evaluates in the vertex shader up to this order and in texture space above it:
     // measured on llvmpipe (scripts/bench-runtime, docs/runtime.md), vertex decompression is
     // 0.65x the rho path's frame at order 1 but 1.3-1.8x at orders 4 and 8, where the texture
-    // pass is 0.8-0.9x. Asked for explicitly, vertex decompression holds at every order.
+    // pass is 0.8-0.9x. Asked for explicitly, vertex decompression holds at every order; auto
+    // keeps a bake's error model, which is folded in texture space (a grid-basis bake is order 0).
     static constexpr int kAutoVertexMaxOrder = 1;
     // The SH are evaluated in the shading's vertex shader this frame: allowed (one pass, chosen
     // or auto) and smoothing, which needs D_mu in texture space, off.

@@ -25,8 +25,7 @@ namespace {
 // band 0 a typical error of 0.002 to 0.6 rad per sample, log-uniform, the other bands random, so
 // the prediction varies over the view directions and falls below the offset (where it clamps to
 // 0) on some samples.
-BakeData bakeWithErrors(unsigned seed, int order = 4, int errorOrder = 2) {
-    BakeData d = test::randomBake(order, 3, seed);
+BakeData withErrors(BakeData d, unsigned seed, int errorOrder) {
     d.errorOrder = errorOrder;
     const int n = d.layout.sampleCount(), Ke = d.errorCoefficientCount();
     d.errors.resize(size_t(Ke) * n);
@@ -37,25 +36,30 @@ BakeData bakeWithErrors(unsigned seed, int order = 4, int errorOrder = 2) {
             d.errors[size_t(k) * n + i] = k == 0 ? logTypical(rng) * std::sqrt(4.0f * float(M_PI)) : u(rng);
     return d;
 }
+BakeData bakeWithErrors(unsigned seed, int order = 4, int errorOrder = 2) {
+    return withErrors(test::randomBake(order, 3, seed), seed, errorOrder);
+}
 
 class ErrorFoldTest : public test::HeadlessTest {
 protected:
-    std::unique_ptr<Refractor> make(const Bake& bake, const std::string& path, bool errorModel) {
+    std::unique_ptr<Refractor> make(const Bake& bake, const std::string& path, bool errorModel,
+                                    DecompressionSite site = DecompressionSite::Texture) {
         RefractorOptions o;
         o.path = parseName<RefractorPath>(path);
-        o.decompression = DecompressionSite::Texture;
+        o.decompression = site;
         o.errorModel = errorModel;
         o.loader = context_->loader();
         return Refractor::create(bake, o);
     }
 
     // The fold of `data` on both paths against the CPU's predictedError and resultantOfSigma.
-    void expectFoldMatchesCpu(const BakeData& data) {
+    void expectFoldMatchesCpu(const BakeData& data, DecompressionSite site = DecompressionSite::Texture) {
         const Bake bake = makeBake(data);
         const glm::vec3 eye(0.4f, 0.9f, 2.7f);
         size_t clamped = 0;
         for (const char* path : {"rho", "direct"}) {
-            auto folded = make(bake, path, true), plain = make(bake, path, false);
+            auto folded = make(bake, path, true, site), plain = make(bake, path, false, site);
+            EXPECT_EQ(folded->decompression(), DecompressionSite::Texture) << path << ": the fold needs D_mu";
             folded->update(FrameView::fromEye(eye));
             plain->update(FrameView::fromEye(eye));
             const std::vector<float> f = folded->readDirectionalMap(), p = plain->readDirectionalMap();
@@ -89,6 +93,14 @@ TEST_P(ErrorFoldTest, LengthIsThePredictedLobeAndDirectionIsKept) {
 // the fold reach the model's order, not a fixed count.
 TEST_P(ErrorFoldTest, TheLargestModelFoldsAsTheCpuPredicts) {
     expectFoldMatchesCpu(bakeWithErrors(12, 8, limits::kMaxErrorOrder));
+}
+
+// A grid-basis bake (order 0) with a model: auto decompression would evaluate it in the vertex
+// shader, where nothing folds the model in; it takes texture space instead, and the fold is the
+// CPU's. Planted: auto choosing vertex at order 0 regardless fails the site check on the direct path.
+TEST_P(ErrorFoldTest, AGridBakesModelFoldsUnderAutoDecompression) {
+    expectFoldMatchesCpu(withErrors(test::randomGridBake(DirectionGrid{8, 16}, 3, 13), 13, 2),
+                         DecompressionSite::Auto);
 }
 
 TEST_P(ErrorFoldTest, BakesWithoutAModelDecompressAsBefore) {

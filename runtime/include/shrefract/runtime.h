@@ -212,7 +212,8 @@ struct RefractorOptions {
     // Spread shading takes the lobe width from the bake's error model, its predicted angular error
     // at each sample and view direction, where the bake has one (format version 3; docs/runtime.md
     // "Error model"); off, or on older bakes, from the SH reconstruction's length alone. Applies
-    // where D_mu is decompressed in texture space (not to vertex decompression).
+    // where D_mu is decompressed in texture space, which auto decompression then picks; vertex
+    // decompression, asked for, goes without it.
     bool errorModel = true;
     // Chart layouts (isolated, uv; paper §5.2): gutter rings filled around the charts by
     // dilation (-1: the bake's gutter; 0: none), and whether gutter texels next to a smooth seam

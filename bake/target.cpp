@@ -15,6 +15,7 @@
 #include "common/decompress.h"
 #include "common/error.h"
 #include "common/frame.h"
+#include "common/limits.h"
 #include "common/sh.h"
 
 namespace shrefract {
@@ -40,21 +41,25 @@ double angleDeg(glm::vec3 a, glm::vec3 b) {
     return std::acos(std::clamp(double(glm::dot(a / la, b)), -1.0, 1.0)) * 180.0 / M_PI;
 }
 
-TargetCandidate candidate(int order, int rate, const DirectionGrid& grid, Precision p, size_t samples) {
+// An SH candidate of `order`, or with `basis` Grid the grid basis (order 0).
+TargetCandidate candidate(Basis basis, int order, int rate, const DirectionGrid& grid, Precision p, size_t samples) {
     TargetCandidate c;
-    c.order = order, c.rate = rate, c.grid = grid, c.precision = p, c.samples = samples;
-    c.weightBytes = samples * weightsTexelBytes(shEvenCount(order), p);
+    c.basis = basis;
+    c.order = basis == Basis::Grid ? 0 : order;
+    c.rate = rate, c.grid = grid, c.precision = p, c.samples = samples;
+    c.weightBytes = samples * weightsTexelBytes(basisCoefficients(basis, c.order, grid), p);
     c.bakeCost = double(samples) * grid.count();
     return c;
 }
 
 bool isPaperModel(const TargetCandidate& c, int baseRate) {
-    return c.order == 8 && c.rate == baseRate && c.grid.nTheta == 32 && c.grid.nPhi == 64 &&
-           c.precision == Precision::F32;
+    return c.basis == Basis::Sh && c.order == 8 && c.rate == baseRate && c.grid.nTheta == 32 &&
+           c.grid.nPhi == 64 && c.precision == Precision::F32;
 }
 
 std::string describe(const TargetCandidate& c) {
-    return str("order ", c.order, ", rate ", c.rate, ", ", nameOf(c.precision), ": ", c.weightBytes / 1e6, " MB");
+    const std::string model = c.basis == Basis::Grid ? "grid basis " + c.grid.ToString() : str("order ", c.order);
+    return str(model, ", rate ", c.rate, ", ", nameOf(c.precision), ": ", c.weightBytes / 1e6, " MB");
 }
 
 // The angles (degrees, sorted) between each pair's truth and the prediction interpolated from
@@ -80,7 +85,7 @@ std::vector<double> errorsDeg(const SurfaceLayout& L, const std::vector<HeldOutP
 
 nlohmann::json TargetSearchResult::ToJson() const {
     auto cj = [](const TargetCandidate& c) {
-        return nlohmann::json{{"order", c.order}, {"rate", c.rate}, {"grid", c.grid.ToString()},
+        return nlohmann::json{{"basis", nameOf(c.basis)}, {"order", c.order}, {"rate", c.rate}, {"grid", c.grid.ToString()},
                               {"precision", nameOf(c.precision)}, {"medianDeg", c.medianDeg},
                               {"p95Deg", c.p95Deg}, {"meanDeg", c.meanDeg}, {"samples", c.samples},
                               {"weightMB", c.weightBytes / 1e6}, {"paths", c.bakeCost}};
@@ -144,18 +149,26 @@ TargetSearchResult searchTarget(const Scene& scene, const BakeOptions& base,
 
     // What gets fitted: in a budget search only what fits in it, and the paper's model (the
     // comparison printed beside the choice).
+    auto searches = [&](Basis b) { return std::find(opt.bases.begin(), opt.bases.end(), b) != opt.bases.end(); };
     auto fits = [&](const TargetCandidate& c) { return !budget || c.weightBytes <= opt.budgetBytes; };
-    auto wanted = [&](const TargetCandidate& c) {
-        return fitCanSolve(base.fit, c.order, c.grid) && (fits(c) || isPaperModel(c, baseRate));
+    // Searched: SH orders the fit can solve at the grid, the grid basis at grids it can hold.
+    auto searched = [&](const TargetCandidate& c) {
+        return searches(c.basis) && (c.basis == Basis::Grid ? c.grid.count() <= limits::kMaxGridBasis
+                                                              : fitCanSolve(base.fit, c.order, c.grid));
     };
+    auto wanted = [&](const TargetCandidate& c) { return searched(c) && (fits(c) || isPaperModel(c, baseRate)); };
     if (budget) {
         const TargetCandidate* cheapest = nullptr;
         std::vector<TargetCandidate> each;
         for (int r : rates)
-            for (int L : opt.orders)
-                for (Precision p : opt.precisions)
-                    for (const DirectionGrid& g : opt.grids)
-                        if (fitCanSolve(base.fit, L, g)) each.push_back(candidate(L, r, g, p, samplesAt[r]));
+            for (Precision p : opt.precisions)
+                for (const DirectionGrid& g : opt.grids) {
+                    for (int L : opt.orders)
+                        if (TargetCandidate c = candidate(Basis::Sh, L, r, g, p, samplesAt[r]); searched(c))
+                            each.push_back(c);
+                    if (TargetCandidate c = candidate(Basis::Grid, 0, r, g, p, samplesAt[r]); searched(c))
+                        each.push_back(c);
+                }
         for (const TargetCandidate& c : each)
             if (!cheapest || c.weightBytes < cheapest->weightBytes) cheapest = &c;
         if (!cheapest || cheapest->weightBytes > opt.budgetBytes)
@@ -174,11 +187,15 @@ TargetSearchResult searchTarget(const Scene& scene, const BakeOptions& base,
             std::vector<int> orders;
             for (int L : opt.orders)
                 for (Precision p : opt.precisions)
-                    if (wanted(candidate(L, r, grid, p, samplesAt[r]))) {
+                    if (wanted(candidate(Basis::Sh, L, r, grid, p, samplesAt[r]))) {
                         orders.push_back(L);
                         break;
                     }
-            if (orders.empty()) continue;
+            // And the grid basis, at some precision.
+            const bool gridBasis = std::any_of(opt.precisions.begin(), opt.precisions.end(), [&](Precision p) {
+                return wanted(candidate(Basis::Grid, 0, r, grid, p, samplesAt[r]));
+            });
+            if (orders.empty() && !gridBasis) continue;
             if (!layout) layout = std::make_unique<SurfaceLayout>(buildJoiningLayout(scene, r));
             const SurfaceLayout& L = *layout;
             // Only the samples the held-out triangles touch are traced: `local` numbers them.
@@ -191,7 +208,8 @@ TargetSearchResult searchTarget(const Scene& scene, const BakeOptions& base,
 
             if (opt.log)
                 opt.log(str("rate ", r, ", grid ", grid.ToString(), ": tracing ", ids.size(), " of ",
-                            samplesAt[r], " samples, fitting ", orders.size(), " orders"));
+                            samplesAt[r], " samples, fitting ", orders.size(), " orders",
+                            gridBasis ? " and the grid basis" : ""));
             // Each order fitted as the bake fits it (bake/fit.h), one sample at a time.
             std::vector<std::unique_ptr<SampleFit>> fitters;
             for (int order : orders)
@@ -202,6 +220,8 @@ TargetSearchResult searchTarget(const Scene& scene, const BakeOptions& base,
             for (size_t o = 0; o < orders.size(); ++o)
                 weights[o].assign(size_t(fitters[o]->coefficients()) * ids.size() * 4, 0.0f);
             const int J = grid.count();
+            // The grid basis's weights: the traced values themselves, as a bake stores them.
+            std::vector<float> traced(gridBasis ? size_t(J) * ids.size() * 4 : 0);
             tbb::parallel_for(size_t(0), ids.size(), [&](size_t s) {
                 enableFlushToZero();
                 const uint32_t i = ids[s];
@@ -211,6 +231,8 @@ TargetSearchResult searchTarget(const Scene& scene, const BakeOptions& base,
                 for (int j = 0; j < J; ++j) {
                     paths[j] = tracer.trace(L.position[i], L.normal[i], f.fromLocal(glm::vec3(grid.direction(j))), L.part[i]);
                     R.row(j) << paths[j].exit.x, paths[j].exit.y, paths[j].exit.z, paths[j].length;
+                    if (gridBasis)
+                        for (int c = 0; c < 4; ++c) traced[(size_t(j) * ids.size() + s) * 4 + c] = R(j, c);
                 }
                 for (size_t o = 0; o < orders.size(); ++o) {
                     Wt.resize(4, fitters[o]->coefficients());
@@ -219,40 +241,46 @@ TargetSearchResult searchTarget(const Scene& scene, const BakeOptions& base,
                         for (int c = 0; c < 4; ++c) weights[o][(size_t(k) * ids.size() + s) * 4 + c] = Wt(c, k);
                 }
             });
-            // Each order at each wanted precision, measured on the pairs through a bake that
-            // holds the traced samples only (the others are never looked up).
+            // Each wanted candidate, measured on the pairs through a bake that holds the traced
+            // samples only (the others are never looked up).
             BakeData partial;
             partial.layout.position.resize(ids.size());
             partial.layout.normal.resize(ids.size());
             for (size_t s = 0; s < ids.size(); ++s)
                 partial.layout.position[s] = L.position[ids[s]], partial.layout.normal[s] = L.normal[ids[s]];
-            for (size_t o = 0; o < orders.size(); ++o) {
-                for (Precision p : opt.precisions) {
-                    TargetCandidate c = candidate(orders[o], r, grid, p, samplesAt[r]);
-                    if (!wanted(c)) continue;
-                    partial.order = orders[o];
-                    partial.precision = p;
-                    partial.weights = weights[o];
-                    partial.u8Scale.clear(), partial.u8Offset.clear();  // set again for u8 below
-                    // A fit that still came out non-finite (the bake would refuse it, BakePlan::data)
-                    // predicts nothing (180 deg).
-                    const bool finite = std::all_of(partial.weights.begin(), partial.weights.end(),
-                                                    [](float w) { return std::isfinite(w); });
-                    if (finite) quantizeWeights(partial);
-                    const std::vector<double> err =
-                        finite ? errorsDeg(L, pairs, [&](uint32_t id, glm::vec3 omega) {
-                            const int s = local.at(id);
-                            return decompressSample(partial, s, localViewDirection(partial.layout, s, omega));
-                        })
-                               : std::vector<double>(pairs.size(), 180.0);
-                    c.medianDeg = err[err.size() / 2];
-                    c.p95Deg = err[size_t(0.95 * (err.size() - 1))];
-                    double sum = 0;
-                    for (double e : err) sum += e;
-                    c.meanDeg = sum / err.size();
-                    if (isPaperModel(c, baseRate)) result.reference = c;
-                    if (fits(c)) result.all.push_back(c);
-                }
+            // Candidate c with weights w, measured and kept.
+            auto measure = [&](TargetCandidate c, const std::vector<float>& w) {
+                partial.basis = c.basis;
+                partial.order = c.order;
+                partial.grid = grid;
+                partial.precision = c.precision;
+                partial.weights = w;
+                partial.u8Scale.clear(), partial.u8Offset.clear();  // set again for u8 below
+                // A fit that still came out non-finite (the bake would refuse it, BakePlan::data)
+                // predicts nothing (180 deg).
+                const bool finite = std::all_of(partial.weights.begin(), partial.weights.end(),
+                                                [](float x) { return std::isfinite(x); });
+                if (finite) quantizeWeights(partial);
+                const std::vector<double> err =
+                    finite ? errorsDeg(L, pairs, [&](uint32_t id, glm::vec3 omega) {
+                        const int s = local.at(id);
+                        return decompressSample(partial, s, localViewDirection(partial.layout, s, omega));
+                    })
+                           : std::vector<double>(pairs.size(), 180.0);
+                c.medianDeg = err[err.size() / 2];
+                c.p95Deg = err[size_t(0.95 * (err.size() - 1))];
+                double sum = 0;
+                for (double e : err) sum += e;
+                c.meanDeg = sum / err.size();
+                if (isPaperModel(c, baseRate)) result.reference = c;
+                if (fits(c)) result.all.push_back(c);
+            };
+            for (Precision p : opt.precisions) {
+                for (size_t o = 0; o < orders.size(); ++o)
+                    if (TargetCandidate c = candidate(Basis::Sh, orders[o], r, grid, p, samplesAt[r]); wanted(c))
+                        measure(c, weights[o]);
+                if (TargetCandidate c = candidate(Basis::Grid, 0, r, grid, p, samplesAt[r]); gridBasis && wanted(c))
+                    measure(c, traced);
             }
         }
     }

@@ -1,5 +1,5 @@
-// The least model a scene needs, or the best one a budget buys: a search over (order, rate,
-// grid, precision) by the median angular error on held-out (point, direction) pairs
+// The least model a scene needs, or the best one a budget buys: a search over (basis, order,
+// rate, grid, precision) by the median angular error on held-out (point, direction) pairs
 // (`shrefract-bake --target-error DEG` and `--budget MB`; docs/bake.md "Choosing the model").
 #pragma once
 
@@ -14,6 +14,7 @@
 namespace shrefract {
 
 struct TargetCandidate {
+    Basis basis = Basis::Sh;  // Grid: the traced grid itself, order 0 (docs/bake.md "The grid basis")
     int order = 8, rate = 1;
     DirectionGrid grid;
     Precision precision = Precision::F32;
@@ -38,6 +39,9 @@ struct TargetSearchOptions {
     std::vector<int> rates;   // empty: 1, 2, 3 and the base options' rate
     std::vector<DirectionGrid> grids{{8, 16}, {16, 32}, {32, 64}, {64, 128}};
     std::vector<Precision> precisions{Precision::F32, Precision::F16, Precision::U8};
+    // Sh: every order at every grid; Grid: the grid itself, for the grids the runtime can hold
+    // as a basis (limits::kMaxGridBasis directions).
+    std::vector<Basis> bases{Basis::Sh, Basis::Grid};
     std::function<void(const std::string&)> log;  // a line per (rate, grid) traced; may be empty
 };
 
@@ -64,8 +68,8 @@ std::vector<HeldOutPair> heldOutPairs(const Scene& scene, const TraceOptions& tr
 // the same scene.
 std::vector<double> heldOutErrorsDeg(const BakeData& bake, const std::vector<HeldOutPair>& pairs);
 
-// Each candidate is fitted as the bake would fit it (the base options' fit, band filter and
-// weighting) and rounded to its precision (u8's scale and offset from the traced samples, not
+// Each SH candidate is fitted as the bake would fit it (the base options' fit, band filter and
+// weighting), each grid-basis one is the traced grid, and each is rounded to its precision (u8's scale and offset from the traced samples, not
 // the whole bake's); only the samples the held-out triangles touch are traced, once per (rate,
 // grid). A Budget search fits no candidate over the budget, and traces no (rate, grid) that has
 // none within it. Throws InputError when no candidate fits the budget, naming the cheapest.

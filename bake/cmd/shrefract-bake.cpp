@@ -94,14 +94,15 @@ int main(int argc, char** argv) {
     app.add_option("--threads", opt.threads, "worker threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
     app.add_option("--cache", cache, "folder for cached compression matrices (empty: none)")->capture_default_str();
     app.add_option("--target-error", targetError,
-                   "pick the smallest order, rate and grid whose median error on held-out "
-                   "directions is at most DEG degrees (overrides --order, --rate, --grid)")
+                   "pick the smallest basis, order, rate and grid whose median error on held-out "
+                   "directions is at most DEG degrees (overrides --order, --rate, --grid; a given "
+                   "--basis or --precision limits the search to it)")
         ->check(CLI::Range(0.001, 180.0));
     double budgetMB = 0;
     app.add_option("--budget", budgetMB,
-                   "pick the order, rate, grid and precision with the lowest median error on "
+                   "pick the basis, order, rate, grid and precision with the lowest median error on "
                    "held-out directions whose weights fit in MB megabytes (10^6 bytes; overrides "
-                   "--order, --rate, --grid; a given --precision limits the search to it)")
+                   "--order, --rate, --grid; a given --basis or --precision limits the search to it)")
         ->check(CLI::PositiveNumber)->excludes("--target-error");
     app.add_option("--target-report", targetReport, "write the --target-error or --budget search as JSON");
     std::string shardText, workDir, tracer = "coherent";
@@ -136,8 +137,6 @@ int main(int argc, char** argv) {
                 for (const char* o : {"--order", "--fit", "--fit-weighting", "--filter"})
                     if (app.count(o) > 0)
                         throw InputError(str(o, " shapes an SH fit; --basis grid stores the traced grid unfitted"));
-                if (targetError > 0 || budgetMB > 0)
-                    throw InputError("--target-error and --budget search SH models; not with --basis grid");
             }
             if (opt.layout != LayoutKind::Joining && rate > 0)
                 throw InputError("--rate is for --layout joining; chart layouts take --samples or --texels");
@@ -194,8 +193,9 @@ int main(int argc, char** argv) {
                 topt.targetDeg = targetError;
                 topt.budgetBytes = static_cast<size_t>(budgetMB * 1e6);
                 if (app.count("--precision") > 0) topt.precisions = {opt.precision};
+                if (app.count("--basis") > 0) topt.bases = {opt.basis};
                 if (!quiet) {
-                    std::fprintf(stderr, "%s: searching order, rate, grid and precision on held-out pairs...\n",
+                    std::fprintf(stderr, "%s: searching basis, order, rate, grid and precision on held-out pairs...\n",
                                  searchFlag);
                     topt.log = [](const std::string& line) { std::fprintf(stderr, "  %s\n", line.c_str()); };
                 }
@@ -206,15 +206,16 @@ int main(int argc, char** argv) {
                     std::printf("target-error %.3g deg: %s", targetError, t.reached ? "chose" : "NOT REACHED; most accurate is");
                 else
                     std::printf("budget %.3g MB: chose", budgetMB);
-                std::printf(" order %d, rate %d, grid %s, %s: median %.2f deg, p95 %.1f deg, %.2f MB of weights\n",
-                            c.order, c.rate, c.grid.ToString().c_str(), nameOf(c.precision), c.medianDeg,
-                            c.p95Deg, c.weightBytes / 1e6);
+                std::printf(" %s, rate %d, grid %s, %s: median %.2f deg, p95 %.1f deg, %.2f MB of weights\n",
+                            c.basis == Basis::Grid ? "the grid basis" : str("order ", c.order).c_str(), c.rate,
+                            c.grid.ToString().c_str(), nameOf(c.precision), c.medianDeg, c.p95Deg, c.weightBytes / 1e6);
                 std::printf("  paper's fixed model (order 8, rate %d, grid 32x64, f32): median %.2f deg, %.1f MB of "
                             "weights, %.3g paths\n", p.rate, p.medianDeg, p.weightBytes / 1e6, p.bakeCost);
                 std::printf("  chosen: %.2fx less memory, %.2fx less tracing\n",
                             double(p.weightBytes) / std::max<size_t>(1, c.weightBytes),
                             p.bakeCost / std::max(1.0, c.bakeCost));
                 if (!targetReport.empty()) writeFile(stagedReport, t.ToJson().dump(2) + "\n");
+                opt.basis = c.basis;
                 opt.order = c.order;
                 opt.rate = c.rate;
                 opt.grid = c.grid;

@@ -39,18 +39,22 @@ TargetSearchOptions small() {
 
 double median(const std::vector<double>& sorted) { return sorted[sorted.size() / 2]; }
 
-// Each candidate is fitted as the bake fits (the weighted fit, here) and rounded as its file
-// holds it: its median equals a whole bake's at its settings, on the same pairs.
+// Each SH candidate is fitted as the bake fits (the weighted fit, here), each grid-basis one is
+// the traced grid, and each is rounded as its file holds it: its median equals a whole bake's at
+// its settings, on the same pairs.
 TEST(Target, SearchMediansEqualWholeBakes) {
     const TargetSearchOptions o = small();
     const TargetSearchResult r = searchTarget(sphere(), base(), o);
-    ASSERT_EQ(r.all.size(), 2u * 2u * 2u * 3u);  // orders x rates x grids x precisions
+    // (orders + the grid basis) x rates x grids x precisions
+    ASSERT_EQ(r.all.size(), (2u + 1u) * 2u * 2u * 3u);
     const std::vector<HeldOutPair> pairs = heldOutPairs(sphere(), base().trace, o);
     double worst = 0, worstU8 = 0;
+    int gridBases = 0;
     for (const TargetCandidate& c : r.all) {
-        if (c.grid.nTheta != 8) continue;  // the 8x16 grid's 12 keep the test short
+        if (c.grid.nTheta != 8) continue;  // the 8x16 grid's 18 keep the test short
         BakeOptions b = base();
-        b.order = c.order, b.rate = c.rate, b.grid = c.grid, b.precision = c.precision;
+        b.basis = c.basis, b.order = c.order, b.rate = c.rate, b.grid = c.grid, b.precision = c.precision;
+        gridBases += c.basis == Basis::Grid;
         const BakeData whole = bake(sphere(), b, "sphere").data;
         EXPECT_EQ(whole.layout.position.size(), c.samples);
         EXPECT_EQ(whole.weights.size() / 4 / whole.coefficientCount() *
@@ -60,6 +64,7 @@ TEST(Target, SearchMediansEqualWholeBakes) {
         double& w = c.precision == Precision::U8 ? worstU8 : worst;
         w = std::max(w, d);
     }
+    EXPECT_EQ(gridBases, 6);
     std::printf("median |search - whole bake|: f32 and f16 %.3g deg, u8 %.3g deg\n", worst, worstU8);
     // The same traces, fit and rounding: measured equal (0 deg). On this sphere the pairs touch
     // every sample, so even u8's scale and offset are the whole bake's. The bound is a float's

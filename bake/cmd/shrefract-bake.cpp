@@ -336,8 +336,10 @@ int main(int argc, char** argv) {
                             s.samples, L.rate, L.triangleCount, L.muWidth, L.muHeight, L.rhoWidth, L.rhoHeight,
                             s.rhoOverhead);
             }
-            std::printf("  paths       %zu (%d directions), rays %zu (%.2f per path)\n", s.paths,
-                        opt.grid.count(), s.rays, double(s.rays) / std::max<size_t>(1, s.paths));
+            std::printf("  paths       %zu (%zu directions per sample%s), rays %zu (%.2f per path)\n", s.paths,
+                        s.paths / std::max<size_t>(1, s.samples),
+                        s.paths > s.samples * size_t(opt.grid.count()) ? ", the error model's cell corners included" : "",
+                        s.rays, double(s.rays) / std::max<size_t>(1, s.paths));
             if (nCheckpoints <= 1)
                 std::printf("  time        %.1f s wall (trace %.1f s, compress %.1f s thread time), %.2f Mrays/s\n",
                             s.wallSeconds, s.traceSeconds, s.compressSeconds, s.rays / s.wallSeconds * 1e-6);

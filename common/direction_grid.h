@@ -56,6 +56,7 @@ struct CellCorners {
     std::vector<double> solidAngle;
 };
 CellCorners cellCorners(const DirectionGrid& grid);
+
 // compressionMatrix(), cached on disk in `cacheDir` under a name made of its parameters.
 // A corrupt or mismatched cache file is recomputed and rewritten. Empty cacheDir: no cache.
 Eigen::MatrixXd compressionMatrixCached(const DirectionGrid& grid, int L, const std::string& cacheDir);

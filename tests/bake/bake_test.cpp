@@ -126,6 +126,19 @@ TEST(Bake, StoresTheErrorModelItsGridAndOrderAllow) {
     }
 }
 
+// A grid-basis bake of 6x12 directions in f32, traced one ray at a time on one thread, as the
+// tests' fresh scalar traces are.
+BakeOptions gridBasisOptions() {
+    BakeOptions o;
+    o.basis = Basis::Grid;
+    o.rate = 1;
+    o.threads = 1;
+    o.coherent = false;
+    o.precision = Precision::F32;
+    o.grid = DirectionGrid{6, 12};
+    return o;
+}
+
 // The grid basis stores the traced grid unfitted: read back at a grid direction, every sample's
 // exit and length are what a fresh scalar trace of that path gives (f32 weights, traced one ray
 // at a time as the bake did: measured max difference 3.5e-6, the interpolation's weight of a
@@ -135,13 +148,7 @@ TEST(Bake, StoresTheErrorModelItsGridAndOrderAllow) {
 // gives 42.6.
 TEST(Bake, GridBasisStoresTheTracedGrid) {
     const Scene scene = test::sceneOf(test::icosphere(2), 1.5);
-    BakeOptions o;
-    o.basis = Basis::Grid;
-    o.rate = 1;
-    o.threads = 1;
-    o.coherent = false;
-    o.precision = Precision::F32;
-    o.grid = DirectionGrid{6, 12};
+    BakeOptions o = gridBasisOptions();
     const BakeData d = bake(scene, o, "<memory>").data;
     ASSERT_EQ(d.basis, Basis::Grid);
     EXPECT_EQ(d.order, 0);
@@ -171,13 +178,7 @@ TEST(Bake, GridBasisStoresTheTracedGrid) {
 // Planted: tracing the truth at the grid directions while reading at the corners gives 2.28.
 TEST(Bake, GridBasisModelsItsMissAtTheCorners) {
     const Scene scene = test::sceneOf(test::icosphere(2), 1.5);
-    BakeOptions o;
-    o.basis = Basis::Grid;
-    o.rate = 1;
-    o.threads = 1;
-    o.coherent = false;
-    o.precision = Precision::F32;
-    o.grid = DirectionGrid{6, 12};
+    BakeOptions o = gridBasisOptions();
     o.errorOrder = 2;
     const BakeData d = bake(scene, o, "<memory>").data;
     ASSERT_EQ(d.errorOrder, 2);

@@ -53,8 +53,8 @@ TargetCandidate candidate(Basis basis, int order, int rate, const DirectionGrid&
 }
 
 bool isPaperModel(const TargetCandidate& c, int baseRate) {
-    return c.basis == Basis::Sh && c.order == 8 && c.rate == baseRate && c.grid.nTheta == 32 &&
-           c.grid.nPhi == 64 && c.precision == Precision::F32;
+    return c.basis == Basis::Sh && c.order == 8 && c.rate == baseRate &&
+           c.grid == DirectionGrid{32, 64} && c.precision == Precision::F32;
 }
 
 std::string describe(const TargetCandidate& c) {
@@ -147,16 +147,29 @@ TargetSearchResult searchTarget(const Scene& scene, const BakeOptions& base,
     std::map<int, size_t> samplesAt;
     for (int r : rates) samplesAt[r] = joiningSampleCount(scene, r);
 
-    // What gets fitted: in a budget search only what fits in it, and the paper's model (the
-    // comparison printed beside the choice).
-    auto searches = [&](Basis b) { return std::find(opt.bases.begin(), opt.bases.end(), b) != opt.bases.end(); };
+    // What gets fitted: the candidates searched (in a budget search only those that fit in it),
+    // and the paper's model, the comparison printed beside the choice, whatever the search is
+    // restricted to (--basis grid, --precision u8).
+    auto in = [](const auto& list, const auto& x) { return std::find(list.begin(), list.end(), x) != list.end(); };
     auto fits = [&](const TargetCandidate& c) { return !budget || c.weightBytes <= opt.budgetBytes; };
-    // Searched: SH orders the fit can solve at the grid, the grid basis at grids it can hold.
+    // Searched: the options' SH orders the fit can solve at the grid, the grid basis at grids it can hold.
     auto searched = [&](const TargetCandidate& c) {
-        return searches(c.basis) && (c.basis == Basis::Grid ? c.grid.count() <= limits::kMaxGridBasis
-                                                              : fitCanSolve(base.fit, c.order, c.grid));
+        if (!in(opt.bases, c.basis) || !in(opt.grids, c.grid) || !in(opt.precisions, c.precision)) return false;
+        return c.basis == Basis::Grid ? c.grid.count() <= limits::kMaxGridBasis
+                                      : in(opt.orders, c.order) && fitCanSolve(base.fit, c.order, c.grid);
     };
-    auto wanted = [&](const TargetCandidate& c) { return searched(c) && (fits(c) || isPaperModel(c, baseRate)); };
+    auto kept = [&](const TargetCandidate& c) { return searched(c) && fits(c); };
+    auto wanted = [&](const TargetCandidate& c) {
+        return kept(c) || (isPaperModel(c, baseRate) && fitCanSolve(base.fit, c.order, c.grid));
+    };
+    // The loops' lists: the options' own, with the paper's model added.
+    auto with = [&](auto list, auto x) {
+        if (!in(list, x)) list.push_back(x);
+        return list;
+    };
+    const std::vector<int> everyOrder = with(opt.orders, 8);
+    const std::vector<DirectionGrid> everyGrid = with(opt.grids, DirectionGrid{32, 64});
+    const std::vector<Precision> everyPrecision = with(opt.precisions, Precision::F32);
     if (budget) {
         const TargetCandidate* cheapest = nullptr;
         std::vector<TargetCandidate> each;
@@ -182,17 +195,17 @@ TargetSearchResult searchTarget(const Scene& scene, const BakeOptions& base,
     TargetSearchResult result;
     for (int r : rates) {
         std::unique_ptr<SurfaceLayout> layout;  // built when a grid of this rate is traced
-        for (const DirectionGrid& grid : opt.grids) {
+        for (const DirectionGrid& grid : everyGrid) {
             // The orders with some precision wanted at this (rate, grid).
             std::vector<int> orders;
-            for (int L : opt.orders)
-                for (Precision p : opt.precisions)
+            for (int L : everyOrder)
+                for (Precision p : everyPrecision)
                     if (wanted(candidate(Basis::Sh, L, r, grid, p, samplesAt[r]))) {
                         orders.push_back(L);
                         break;
                     }
             // And the grid basis, at some precision.
-            const bool gridBasis = std::any_of(opt.precisions.begin(), opt.precisions.end(), [&](Precision p) {
+            const bool gridBasis = std::any_of(everyPrecision.begin(), everyPrecision.end(), [&](Precision p) {
                 return wanted(candidate(Basis::Grid, 0, r, grid, p, samplesAt[r]));
             });
             if (orders.empty() && !gridBasis) continue;
@@ -273,9 +286,9 @@ TargetSearchResult searchTarget(const Scene& scene, const BakeOptions& base,
                 for (double e : err) sum += e;
                 c.meanDeg = sum / err.size();
                 if (isPaperModel(c, baseRate)) result.reference = c;
-                if (fits(c)) result.all.push_back(c);
+                if (kept(c)) result.all.push_back(c);
             };
-            for (Precision p : opt.precisions) {
+            for (Precision p : everyPrecision) {
                 for (size_t o = 0; o < orders.size(); ++o)
                     if (TargetCandidate c = candidate(Basis::Sh, orders[o], r, grid, p, samplesAt[r]); wanted(c))
                         measure(c, weights[o]);

@@ -47,9 +47,11 @@ struct TargetSearchOptions {
 
 struct TargetSearchResult {
     TargetCandidate chosen;     // by the goal; for Error, the most accurate when none meets it
-    TargetCandidate reference;  // the paper's fixed model: order 8, the base rate, 32 x 64, f32
+    // The paper's fixed model: order 8, the base rate, 32 x 64, f32; measured whatever the options
+    // restrict the search to.
+    TargetCandidate reference;
     bool reached = false;       // Error: a candidate met the target (Budget: always)
-    std::vector<TargetCandidate> all;  // every candidate fitted (Budget: those within it, and the reference)
+    std::vector<TargetCandidate> all;  // every candidate searched (Budget: those within it)
     nlohmann::json ToJson() const;
 };
 

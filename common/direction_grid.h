@@ -17,6 +17,8 @@ struct DirectionGrid {
     int nTheta = 32, nPhi = 64;
 
     int count() const { return nTheta * nPhi; }
+    bool operator==(const DirectionGrid& o) const { return nTheta == o.nTheta && nPhi == o.nPhi; }
+    bool operator!=(const DirectionGrid& o) const { return !(*this == o); }
     double theta(int i) const;
     double phi(int k) const;
     glm::dvec3 direction(int j) const;

@@ -213,8 +213,8 @@ int main(int argc, char** argv) {
 
         for (int rate : rates) {
             for (const DirectionGrid& grid : grids) {
-                const bool base = rate == baseRate && grid.nTheta == 32 && grid.nPhi == 64;
-                if (!base && rate != baseRate && !(grid.nTheta == 32 && grid.nPhi == 64)) continue;
+                const bool base = rate == baseRate && grid == DirectionGrid{32, 64};
+                if (!base && rate != baseRate && grid != DirectionGrid{32, 64}) continue;
                 BakeOptions bo;
                 bo.rate = rate, bo.grid = grid, bo.order = base ? Lmax : 8, bo.threads = 0;
                 bo.cacheDir = "";

@@ -115,7 +115,7 @@ void RenderMethod::Impl::setUpSh(const Camera& camera, nlohmann::json& summary) 
                 joining ? "rho" : "atlas", refractor->refractionMapSize().x,
                 refractor->refractionMapSize().y, refractor->order(), refractor->passCount(),
                 nameOf(options.preset), nameOf(refractor->path()), nameOf(refractor->decompression()),
-                nameOf(options.shading), refractor->memory().total() / 1e6);
+                nameOf(refractor->shading()), refractor->memory().total() / 1e6);
     if (!joining)
         std::printf("charts: gutter %d texels, seam-aware %s\n", refractor->gutter(),
                     refractor->seamAware() ? "on" : "off");
@@ -123,7 +123,7 @@ void RenderMethod::Impl::setUpSh(const Camera& camera, nlohmann::json& summary) 
     summary["passes"] = refractor->passCount();
     summary["path"] = nameOf(refractor->path());
     summary["decompression"] = nameOf(refractor->decompression());
-    summary["shading"] = nameOf(options.shading);
+    summary["shading"] = nameOf(refractor->shading());
     if (!r.dumpDir.empty()) refractor->dumpShaders(r.dumpDir);
     if (!joining) {  // the map's own jump across the seams
         refractor->update(FrameView::fromEye(camera.eye));

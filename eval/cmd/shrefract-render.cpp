@@ -74,7 +74,8 @@ int main(int argc, char** argv) {
     cli::addEnumOption(app, "--shading", sh.shading,
                        "sh: spread (lobes from the predicted error, or the SH length, and the pixel "
                        "footprint) | sharp (the paper's lookup) | blend (the two mixed by the lobe's "
-                       "width) | jitter (one stable direction drawn from the lobe)");
+                       "width) | jitter (one stable direction drawn from the lobe) | auto (jitter "
+                       "on SH bakes, blend on grid-basis ones)");
     app.add_option("--jitter-cell", sh.jitterCell, "sh, jitter shading: the cell of one drawn direction, a fraction of the object's bounding-box diagonal")
         ->capture_default_str()->check(CLI::Range(1e-6f, 10.0f));
     app.add_option("--blend-sigma", sh.blendSigma, "sh, blend shading: lobe width (radians) at which the lobe has half the weight")

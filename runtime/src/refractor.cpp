@@ -91,6 +91,10 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
     m->settings.smoothing = options.smoothing;
     m->settings.correction = options.correction;
     m->diagonal = samplesDiagonal(L);
+    // Auto shading: the one measured best for the bake's basis (docs/runtime.md "Shading where
+    // the bake is unsure": scripts/compare's chart).
+    if (options.shading == Shading::Auto)
+        m->options.shading = d.basis == Basis::Grid ? Shading::Blend : Shading::Jitter;
     GLint units = 16;
     glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &units);
     const PipelineInputs in{bake,        m->options,         m->settings, m->maxOrder,
@@ -222,6 +226,7 @@ void Refractor::setIorBracket(Refractor* other) {
 glm::ivec2 Refractor::refractionMapSize() const { return impl_->pipeline->refractionMapSize(); }
 RefractorPath Refractor::path() const { return impl_->pipeline->path(); }
 DecompressionSite Refractor::decompression() const { return impl_->pipeline->decompressionSite(); }
+Shading Refractor::shading() const { return impl_->options.shading; }
 
 void Refractor::setOrder(int L) {
     // As RefractorOptions::order: -1 is every uploaded band, above maxOrder clamps to it.

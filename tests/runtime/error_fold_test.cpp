@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <random>
+#include <tuple>
 
 #include "bake_data.h"
 #include "common/decompress.h"
@@ -191,6 +192,32 @@ TEST_P(ErrorFoldTest, JitterDrawsFromThePredictedLobe) {
     // the wrong width (the error not read, a missing sqrt(-2 ln u)) is off by 30 % or more.
     EXPECT_NEAR(rms, expected, 0.1 * expected);
     EXPECT_LT(centre, 0.03);
+}
+
+// Auto shading is jitter on an SH bake and blend on a grid-basis one: the same pixels as the
+// shading named, and others than the shading of the other basis (both bakes carry a model, so
+// every lobe shading draws something else). Planted: auto as jitter on every bake fails the grid's
+// equality.
+TEST_P(ErrorFoldTest, AutoShadingIsJitterOnShAndBlendOnAGrid) {
+    const Environment env = directionEnvironment();
+    auto frame = [&](const Bake& bake, Shading s, Shading* resolved = nullptr) {
+        RefractorOptions o;
+        o.loader = context_->loader();
+        o.shading = s;
+        auto r = Refractor::create(bake, o);
+        if (resolved) *resolved = r->shading();
+        return renderFrame(*r, env, Camera::orbit(30, 20, 3.5f), 64, 64).color;
+    };
+    const Bake sh = makeBake(bakeWithErrors(21));
+    const Bake grid = makeBake(withErrors(test::randomGridBake(DirectionGrid{8, 16}, 3, 21), 21, 2));
+    for (const auto& [bake, expected, other] :
+         {std::tuple{&sh, Shading::Jitter, Shading::Blend}, std::tuple{&grid, Shading::Blend, Shading::Jitter}}) {
+        Shading resolved = Shading::Auto;
+        const std::vector<float> autoFrame = frame(*bake, Shading::Auto, &resolved);
+        EXPECT_EQ(resolved, expected);
+        EXPECT_EQ(autoFrame, frame(*bake, expected)) << nameOf(expected);
+        EXPECT_NE(autoFrame, frame(*bake, other)) << nameOf(other) << " draws the same pixels";
+    }
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, ErrorFoldTest, ::testing::Values(Backend::Egl, Backend::OSMesa),

@@ -170,10 +170,11 @@ template <> struct EnumNames<DecompressionSite> {
 //   Blend: the sharp lookup and the spread lobe mixed by the lobe's width;
 //   Sharp: the paper's single lookup along the exit direction.
 // The default follows scripts/study-shading (object FLIP, detail ratio; docs/runtime.md).
-enum class Shading { Jitter, Spread, Blend, Sharp };
+enum class Shading { Auto, Jitter, Spread, Blend, Sharp };
 template <> struct EnumNames<Shading> {
     static constexpr const char* what = "shading";
-    static constexpr NamedValue<Shading> table[] = {{Shading::Jitter, "jitter"},
+    static constexpr NamedValue<Shading> table[] = {{Shading::Auto, "auto"},
+                                                    {Shading::Jitter, "jitter"},
                                                     {Shading::Spread, "spread"},
                                                     {Shading::Blend, "blend"},
                                                     {Shading::Sharp, "sharp"}};
@@ -199,7 +200,9 @@ struct RefractorOptions {
     bool halfWeights = false;
     bool smoothing = false;         // spatial smoothing through the bake's neighbour lists
     bool correction = true;         // interpolation-correction texels in rho (paper §5.3.1)
-    Shading shading = Shading::Jitter;
+    // Auto: jitter on an SH bake, blend on a grid-basis one, each the best by object FLIP with the
+    // detail kept (docs/runtime.md "Shading where the bake is unsure"); shading() tells.
+    Shading shading = Shading::Auto;
     float spreadScale = 0.15f;      // lobe width factor on the predicted error (docs/runtime.md)
     float footprintScale = 0.15f;   // screen-space footprint factor
     // Blend: the sharp lookup and the spread lobe mixed, the lobe's share sigma / (sigma +
@@ -262,6 +265,7 @@ public:
     glm::ivec2 refractionMapSize() const;
     RefractorPath path() const;               // Rho, Direct, or Charts for chart bakes
     DecompressionSite decompression() const;  // Texture or Vertex
+    Shading shading() const;                  // as RefractorOptions::shading, Auto resolved
     // Progressive decompression (paper §6): use bands 0..L, as RefractorOptions::order does:
     // -1 is all uploaded bands, above maxOrder clamps to it, below -1 is std::invalid_argument.
     void setOrder(int L);

@@ -182,7 +182,10 @@ TEST(Faults, SigkillAtRandomMomentsLeavesNothing) {
     std::printf("[ faults   ] %d of 20 runs killed, %d wrote a complete new bake first\n",
                 killedBeforeExit, completed);
     EXPECT_GE(killedBeforeExit, 10);             // timing on a shared machine: most, not all
-    EXPECT_LE(completed, 20 - killedBeforeExit + 2);  // killed during their exit: rare
+    // Killed during their exit, after the commit: rare. Under ASan the exit runs LeakSanitizer's
+    // scan, and a clean-clone CI measured 3 such of 18 kills (5 new bakes, 2 exited 0): margin 1.
+    // Kills that all landed after the bake would give about 20.
+    EXPECT_LE(completed, 20 - killedBeforeExit + 4);
     // The next run succeeds, with the cache as the kills left it.
     ASSERT_EQ(runTool(bakeArgs(out, cache), dir / "next.log"), 0) << readFile(dir / "next.log");
     EXPECT_NO_THROW(readBake(out.string()));

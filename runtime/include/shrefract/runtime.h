@@ -163,13 +163,15 @@ template <> struct EnumNames<DecompressionSite> {
 // How the exit direction becomes a colour where the bake is unsure of it (its error model
 // predicts an error, or, without one, the SH reconstruction is short), with a lobe
 // RefractorOptions::spreadScale times that wide:
-//   Jitter (the default): one direction drawn from the lobe, stable on the object, looked up over
+//   Auto (the default): Jitter on an SH bake, Blend on a grid-basis one;
+//   Jitter: one direction drawn from the lobe, stable on the object, looked up over
 //     the pixel's footprint: keeps the contrast the truth has;
 //   Spread: the environment averaged over the lobe (a prefiltered cube map), widened by the
 //     footprint: the lobe's mean;
 //   Blend: the sharp lookup and the spread lobe mixed by the lobe's width;
 //   Sharp: the paper's single lookup along the exit direction.
-// The default follows scripts/study-shading (object FLIP, detail ratio; docs/runtime.md).
+// The defaults follow scripts/study-shading and scripts/compare (object FLIP, detail ratio;
+// docs/runtime.md).
 enum class Shading { Auto, Jitter, Spread, Blend, Sharp };
 template <> struct EnumNames<Shading> {
     static constexpr const char* what = "shading";

@@ -3,14 +3,19 @@
 // does with SHREFRACT_VERTEX_SH, for the glTF mesh of SHREFRACT_sh_refraction (docs/format.md
 // "glTF export"), where each vertex names its sample (_SHREFRACT_SAMPLE) and carries its P and N
 // in the primitive's own coordinates, which uBakeFromLocal takes to the bake's (identity for a bake
-// exported alone; a node's world matrix for a primitive written back into its scene). D is the SH
-// weights evaluated at the sample's local view direction (loop form, sh_eval.glsl, the order a
-// uniform), and with SHREFRACT_ERROR_MODEL the bake's predicted error folded into its length as
+// exported alone; a node's world matrix for a primitive written back into its scene). D is the
+// weights evaluated at the sample's local view direction: the SH (loop form, sh_eval.glsl, the
+// order a uniform), or with SHREFRACT_GRID_THETA and SHREFRACT_GRID_PHI (a grid-basis bake) the
+// bilinear blend of the four traced exits around it (grid_eval.glsl, as the C++ generator's grid
+// pass). With SHREFRACT_ERROR_MODEL the bake's predicted error is folded into D's length as
 // error_fold.frag does per mu texel. The rasterizer interpolates D barycentrically either way, so
 // every pixel gets the C++ direct path's texture-decompressed D (runtime/src/direct_pipeline.cpp).
 #include "frame.glsl"
 #include "sh_eval.glsl"
 #include "resultant.glsl"
+#ifdef SHREFRACT_GRID_THETA
+#include "grid_eval.glsl"
+#endif
 #ifndef SHREFRACT_WEIGHT_PAGES
 #define SHREFRACT_WEIGHT_PAGES 1
 #endif
@@ -23,15 +28,16 @@ uniform mat4 uModel;          // the bake's space -> world
 uniform mat4 uViewProjection;
 uniform mat3 uNormalMatrix;
 uniform vec3 uEyeObject;
-uniform int uOrder;          // SH order used, <= the stored one
+uniform int uOrder;          // SH order used, <= the stored one (0 for a grid)
 // The weight atlas: coefficient k is tile k % uTilesPerPage of page k / uTilesPerPage, tiles
 // uTileSize texels, uTilesPerRow to a row; sample i is texel (i % width, i / width) of a tile.
 uniform ivec2 uTileSize;
 uniform int uTilesPerRow;
 uniform int uTilesPerPage;
-// 8-bit codes read as UNORM: value = texel * uWeightScale[k] + uWeightOffset[k] (scale x 255).
-uniform vec4 uWeightScale[SHREFRACT_SH_MAX_COUNT];
-uniform vec4 uWeightOffset[SHREFRACT_SH_MAX_COUNT];
+// 8-bit codes read as UNORM: value = texel * scale_k + offset_k, texel (k, 0) and (k, 1) of
+// uWeightRange (scale x 255), as the C++ grid pass's uWeightRange (a grid's 512 coefficients
+// would overflow a uniform array).
+uniform highp sampler2D uWeightRange;
 uniform sampler2D uWeightPage0;
 #if SHREFRACT_WEIGHT_PAGES > 1
 uniform sampler2D uWeightPage1;
@@ -71,25 +77,37 @@ vec4 weightTexel(int k, int i) {
     return texelFetch(uWeightPage0, t, 0);
 }
 
+// Coefficient k of sample i, decoded.
+vec4 weight(int k, int i) {
+    return weightTexel(k, i) * texelFetch(uWeightRange, ivec2(k, 0), 0) + texelFetch(uWeightRange, ivec2(k, 1), 0);
+}
+
 void main() {
     int i = int(_shrefract_sample + 0.5);
     vec3 P = (uBakeFromLocal * vec4(position, 1.0)).xyz;
     vec3 N = normalize(uBakeNormal * normal);
     vec3 w = normalize(toLocalFrame(normalize(uEyeObject - P), N));
     // The even functions are band-major, so one evaluation through the larger order serves both
-    // the weights (uOrder) and the error model (uErrorOrder).
+    // the weights (uOrder) and the error model (uErrorOrder); a grid's uOrder is 0.
     float y[SHREFRACT_SH_MAX_COUNT];
 #ifdef SHREFRACT_ERROR_MODEL
     shEvalEven(max(uOrder, uErrorOrder), w, y);
 #else
     shEvalEven(uOrder, w, y);
 #endif
-    int count = (uOrder + 1) * (uOrder + 2) / 2;
     vec4 d = vec4(0.0);
+#ifdef SHREFRACT_GRID_THETA
+    ivec4 corner;
+    vec4 cornerWeight;
+    gridCorners(w, corner, cornerWeight);
+    for (int c = 0; c < 4; ++c) d += cornerWeight[c] * weight(corner[c], i);
+#else
+    int count = (uOrder + 1) * (uOrder + 2) / 2;
     for (int k = 0; k < SHREFRACT_SH_MAX_COUNT; ++k) {
         if (k >= count) break;
-        d += (weightTexel(k, i) * uWeightScale[k] + uWeightOffset[k]) * y[k];
+        d += weight(k, i) * y[k];
     }
+#endif
 #ifdef SHREFRACT_ERROR_MODEL
     int errorCount = (uErrorOrder + 1) * (uErrorOrder + 2) / 2;
     float e = 0.0;

@@ -17,7 +17,7 @@ using namespace shrefract;
 namespace fs = std::filesystem;
 
 int main(int argc, char** argv) {
-    CLI::App app{"shrefract-export: a bake as a glTF 2.0 binary (GLB) with the SH weights in the "
+    CLI::App app{"shrefract-export: a bake as a glTF 2.0 binary (GLB) with the weights (SH or grid) in the "
                  "SHREFRACT_sh_refraction extension, optionally with prefiltered environments"};
     std::string bakePath, output, name, into;
     std::vector<std::string> environments;
@@ -75,7 +75,9 @@ int main(int argc, char** argv) {
         writeFile(staged, std::string(glb.begin(), glb.end()));
         outputs.commit();
         std::printf("wrote %s: %.2f MB", output.c_str(), glb.size() / 1e6);
-        if (what.bake)
+        if (what.bake && bake.basis == Basis::Grid)
+            std::printf(", %d samples, grid basis %s", bake.layout.sampleCount(), bake.grid.ToString().c_str());
+        else if (what.bake)
             std::printf(", %d samples at order %d", bake.layout.sampleCount(), bake.order);
         if (!environments.empty()) std::printf(", %zu environment(s)", environments.size());
         if (!into.empty()) std::printf(", into the scene of %s", into.c_str());

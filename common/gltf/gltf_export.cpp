@@ -22,7 +22,9 @@ namespace shrefract {
 namespace {
 
 constexpr const char* kExtension = "SHREFRACT_sh_refraction";
-constexpr int kExtensionVersion = 1;
+// 2: a refraction names its basis ("sh" or "grid", docs/format.md "glTF export"); version 1 had SH
+// only. Readers of 1 refuse 2, so none reads a grid's weights as SH.
+constexpr int kExtensionVersion = 2;
 
 std::vector<uint8_t> glbBytes(tinygltf::Model& model);
 
@@ -105,10 +107,6 @@ int glassMaterial(tinygltf::Model& model, float ior, glm::vec3 kappa, std::vecto
 
 void checkExportable(const BakeData& d) {
     const SurfaceLayout& L = d.layout;
-    // SHREFRACT_sh_refraction version 1 carries SH weights; the web material evaluates SH.
-    if (d.basis != Basis::Sh)
-        throw InputError("a grid-basis bake (" + d.grid.ToString() +
-                         "): SHREFRACT_sh_refraction carries SH weights; bake with --basis sh");
     if (L.isChartLayout())
         throw InputError(std::string("a ") + nameOf(L.kind) +
                          " (chart) layout: the glTF export draws the joining layout's sample grid; "
@@ -215,6 +213,7 @@ nlohmann::json addRefraction(tinygltf::Model& model, BinaryBuffer& bin, const Ba
     const AtlasLayout& a = atlas.layout;
     nlohmann::json r = {
         {"name", name},
+        {"basis", nameOf(d.basis)},
         {"order", d.order},
         {"coefficientCount", a.coefficients},
         {"sampleCount", N},
@@ -228,6 +227,7 @@ nlohmann::json addRefraction(tinygltf::Model& model, BinaryBuffer& bin, const Ba
         {"absorption", {kappa.x, kappa.y, kappa.z}},
         {"boundsDiagonal", samplesDiagonal(L)},  // as the runtime's Refractor
     };
+    if (d.basis == Basis::Grid) r["grid"] = {d.grid.nTheta, d.grid.nPhi};
     if (d.manifest.contains("branch") && d.manifest["branch"].is_string())
         r["branch"] = d.manifest["branch"];
     if (d.errorOrder >= 0) {

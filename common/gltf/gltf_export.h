@@ -1,6 +1,6 @@
 // A bake as a glTF 2.0 binary file (docs/format.md "glTF export: SHREFRACT_sh_refraction"): the
-// mesh the runtime's direct path draws, the SH weights as RGBA8 PNG atlas pages with a scale and
-// offset per coefficient, the error model, and optionally prefiltered environments. Written
+// mesh the runtime's direct path draws, the weights (SH or the grid basis's traced exits) as RGBA8
+// PNG atlas pages with a scale and offset per coefficient, the error model, and optionally prefiltered environments. Written
 // through Debian's tinygltf; read by web/ (the three.js material).
 #pragma once
 

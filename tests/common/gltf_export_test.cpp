@@ -94,8 +94,10 @@ TEST(GltfExport, WeightsDecodeToTheBakesWithinHalfACode) {
     what.name = "synthetic";
     const tinygltf::Model m = parse(exportGlb(what));
     const json root = rootExtension(m);
-    ASSERT_EQ(root["version"], 1);
+    ASSERT_EQ(root["version"], 2);
     const json& r = root["refractions"][0];
+    EXPECT_EQ(r["basis"], "sh");
+    EXPECT_FALSE(r.contains("grid"));
     const int K = d.coefficientCount(), N = d.layout.sampleCount();
     ASSERT_EQ(r["coefficientCount"], K);
     ASSERT_EQ(r["sampleCount"], N);
@@ -119,6 +121,36 @@ TEST(GltfExport, WeightsDecodeToTheBakesWithinHalfACode) {
     ASSERT_EQ(bytes, d.errors.size() * 4);
     EXPECT_EQ(std::memcmp(e, d.errors.data(), bytes), 0);
     EXPECT_EQ(r["error"]["coefficientCount"], 6);
+}
+
+TEST(GltfExport, GridBakesCarryTheirTracedExits) {
+    // The synthetic bake's samples with a 3 x 6 grid of exits (its 15 random coefficients, three
+    // more at 0.25): the refraction names the basis and the grid, and every exit decodes.
+    BakeData d = test::syntheticBake(Precision::F32);
+    d.basis = Basis::Grid;
+    d.order = 0;
+    d.grid = DirectionGrid{3, 6};
+    d.weights.resize(size_t(d.grid.count()) * d.layout.sampleCount() * 4, 0.25f);
+    GltfExport what;
+    what.bake = &d;
+    const tinygltf::Model m = parse(exportGlb(what));
+    const json root = rootExtension(m);
+    ASSERT_EQ(root["version"], 2);
+    const json& r = root["refractions"][0];
+    EXPECT_EQ(r["basis"], "grid");
+    EXPECT_EQ(r["grid"], json::array({3, 6}));
+    EXPECT_EQ(r["order"], 0);
+    const int K = 18, N = d.layout.sampleCount();
+    ASSERT_EQ(r["coefficientCount"], K);
+    ASSERT_EQ(r["scale"].size(), size_t(4 * K));
+    double worst = 0;
+    for (int k = 0; k < K; ++k)
+        for (int i = 0; i < N; ++i)
+            for (int c = 0; c < 4; ++c) {
+                const double step = std::max(r["scale"][4 * k + c].get<double>(), 1e-12);
+                worst = std::max(worst, std::abs(decoded(m, r, k, i, c) - d.weights[(size_t(k) * N + i) * 4 + c]) / step);
+            }
+    EXPECT_LE(worst, 0.5 + 1e-4);  // the last three coefficients (constant 0.25) included
 }
 
 TEST(GltfExport, U8BakesKeepTheirCodesExactly) {

@@ -57,7 +57,7 @@ function loader() {
   l.register((parser) => new SHRefractionLoaderPlugin(parser, {
     maxTextureSize: renderer.capabilities.maxTextureSize,
     material: {
-      shading: params.get('shading') || 'jitter',
+      shading: params.get('shading') || 'auto',
       order: params.has('order') ? Number(params.get('order')) : -1,
       errorModel: params.get('errorModel') !== '0',
       exposure: Number(params.get('exposure') || 1),
@@ -116,7 +116,7 @@ async function main() {
   if (params.get('env')) select.value = params.get('env');
   select.onchange = () => environment(select.value).then(useEnvironment).catch(showError);
   const shading = document.getElementById('shading');
-  shading.value = params.get('shading') || 'jitter';
+  shading.value = params.get('shading') || 'auto';
   shading.onchange = () => { for (const m of materials) m.shading = shading.value; };
 
   const [gltf, env] = await Promise.all([

@@ -7,7 +7,8 @@ import * as THREE from 'three';
 import { SHRefractionMaterial } from './material.js';
 
 export const EXTENSION = 'SHREFRACT_sh_refraction';
-export const VERSION = 1;
+// 2 names each refraction's basis ("sh" or "grid"); 1 is SH only, read as before.
+export const VERSIONS = [1, 2];
 
 function fail(message) {
   return new Error(`${EXTENSION}: ${message}`);
@@ -42,6 +43,23 @@ export async function loadGlb(loader, url) {
   return loader.parseAsync(buffer, base);
 }
 
+// Coefficient k's decode as texels (k, 0) and (k, 1) of an RGBA32F texture: scale (times 255, as
+// UNORM texels are code / 255) and offset, per channel.
+function weightRangeTexture(r, K, name) {
+  const range = new Float32Array(2 * 4 * K);
+  for (let i = 0; i < 4 * K; ++i) {
+    range[i] = r.scale[i] * 255;
+    range[4 * K + i] = r.offset[i];
+  }
+  const tex = new THREE.DataTexture(range, K, 2, THREE.RGBAFormat, THREE.FloatType);
+  tex.internalFormat = 'RGBA32F';
+  tex.minFilter = tex.magFilter = THREE.NearestFilter;
+  tex.generateMipmaps = false;
+  tex.needsUpdate = true;
+  tex.name = `${name} weight range`;
+  return tex;
+}
+
 function halfView(buffer, byteOffset, count) {
   // Copies: a bufferView's offset need not be aligned to the element size.
   const out = new Uint16Array(count);
@@ -56,9 +74,9 @@ function floatView(buffer, byteOffset, count) {
 }
 
 // Bytes a refraction's textures take on the GPU at the formats they are uploaded in (RGBA8 weight
-// pages, R32F error layers), and its mesh's vertex and index buffers.
+// pages, the RGBA32F weight range, R32F error layers), and its mesh's vertex and index buffers.
 export function gpuBytes(refraction, mesh = null) {
-  let textures = 0;
+  let textures = refraction.weightRange.image.width * refraction.weightRange.image.height * 16;
   for (const t of refraction.pages) textures += t.image.width * t.image.height * 4;
   if (refraction.error) {
     const e = refraction.error.texture.image;
@@ -131,13 +149,26 @@ export class SHRefractionLoaderPlugin {
     return tex;
   }
 
-  async refraction(r, index) {
+  async refraction(r, index, version) {
     const what = `refraction ${index}${r.name ? ` ("${r.name}")` : ''}`;
     for (const key of ['order', 'coefficientCount', 'sampleCount', 'tileSize', 'tilesPerRow',
                        'tilesPerPage', 'weights', 'scale', 'offset', 'ior', 'absorption', 'boundsDiagonal'])
       if (r[key] === undefined) throw fail(`${what} lacks "${key}"`);
-    const K = (r.order + 1) * (r.order + 2) / 2;
-    if (r.coefficientCount !== K) throw fail(`${what}: coefficientCount ${r.coefficientCount}, order ${r.order} has ${K}`);
+    const basis = r.basis ?? 'sh';
+    if (basis !== 'sh' && (version < 2 || basis !== 'grid'))
+      throw fail(`${what}: basis ${JSON.stringify(r.basis)} (version ${version} knows ${version < 2 ? '"sh"' : '"sh" and "grid"'})`);
+    let K = (r.order + 1) * (r.order + 2) / 2, grid = null;
+    if (basis === 'grid') {
+      // [nTheta, nPhi]: nPhi even, as grid_eval.glsl crosses the pole at phi + pi.
+      grid = r.grid;
+      if (!Array.isArray(grid) || grid.length !== 2 || !grid.every(Number.isInteger) || !(grid[0] >= 2) ||
+          !(grid[1] >= 2) || grid[1] % 2)
+        throw fail(`${what}: a grid basis needs "grid": [nTheta, nPhi], integers >= 2, nPhi even; it has ${JSON.stringify(grid)}`);
+      K = grid[0] * grid[1];
+      if (r.coefficientCount !== K) throw fail(`${what}: coefficientCount ${r.coefficientCount}, grid ${grid.join('x')} has ${K}`);
+    } else if (r.coefficientCount !== K) {
+      throw fail(`${what}: coefficientCount ${r.coefficientCount}, order ${r.order} has ${K}`);
+    }
     const [W, H] = r.tileSize;
     if (!(W * H >= r.sampleCount)) throw fail(`${what}: tiles of ${W} x ${H} cannot hold ${r.sampleCount} samples`);
     if (r.scale.length !== 4 * K || r.offset.length !== 4 * K)
@@ -162,7 +193,7 @@ export class SHRefractionLoaderPlugin {
       const e = r.error;
       const Ke = (e.order + 1) * (e.order + 2) / 2;
       if (e.coefficientCount !== Ke) throw fail(`${what}: error coefficientCount ${e.coefficientCount}, order ${e.order} has ${Ke}`);
-      if (e.order > r.order) throw fail(`${what}: error order ${e.order} above the weights' ${r.order}`);
+      if (basis === 'sh' && e.order > r.order) throw fail(`${what}: error order ${e.order} above the weights' ${r.order}`);
       const data = await this.bufferView(e.bufferView, `${what} error`);
       const n = r.sampleCount;
       if (data.byteLength < Ke * n * 4)
@@ -181,10 +212,10 @@ export class SHRefractionLoaderPlugin {
       error = { order: e.order, coefficientCount: Ke, offset: e.offset, texture: tex };
     }
     return {
-      name: r.name ?? `refraction ${index}`,
-      order: r.order, coefficientCount: K, sampleCount: r.sampleCount,
+      name: r.name ?? `refraction ${index}`, basis, grid,
+      order: basis === 'grid' ? 0 : r.order, coefficientCount: K, sampleCount: r.sampleCount,
       tileSize: [W, H], tilesPerRow: r.tilesPerRow, tilesPerPage: r.tilesPerPage,
-      pages: textures, scale: r.scale, offset: r.offset, error,
+      pages: textures, scale: r.scale, offset: r.offset, weightRange: weightRangeTexture(r, K, what), error,
       ior: r.ior, absorption: r.absorption, boundsDiagonal: r.boundsDiagonal, branch: r.branch,
     };
   }
@@ -225,9 +256,9 @@ export class SHRefractionLoaderPlugin {
       if (used.includes(EXTENSION)) throw fail('listed in extensionsUsed but the root holds no extension object');
       return;
     }
-    if (root.version !== VERSION)
-      throw fail(`version ${JSON.stringify(root.version)}; this loader reads version ${VERSION} only`);
-    const refractions = await Promise.all((root.refractions || []).map((r, i) => this.refraction(r, i)));
+    if (!VERSIONS.includes(root.version))
+      throw fail(`version ${JSON.stringify(root.version)}; this loader reads versions ${VERSIONS.join(' and ')}`);
+    const refractions = await Promise.all((root.refractions || []).map((r, i) => this.refraction(r, i, root.version)));
     const environments = await Promise.all((root.environments || []).map((e, i) => this.environment(e, i)));
     const environment = this.options.environment ?? environments[0] ?? null;
     const materials = [];

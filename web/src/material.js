@@ -6,8 +6,14 @@ import * as THREE from 'three';
 import { shaderSource } from './generated/shaders.js';
 import { environmentUniforms, setEnvironmentUniforms, withoutVersion } from './environment.js';
 
-const SHADINGS = ['jitter', 'spread', 'blend', 'sharp'];
+const SHADINGS = ['auto', 'jitter', 'spread', 'blend', 'sharp'];
 
+// Auto: the shading measured best for the bake's basis, as the C++ Refractor's (docs/runtime.md
+// "Shading where the bake is unsure"): blend on a grid, jitter on SH.
+export function resolveShading(shading, refraction) {
+  if (shading !== 'auto') return shading;
+  return refraction.basis === 'grid' ? 'blend' : 'jitter';
+}
 
 const _m3 = new THREE.Matrix3();
 const _m4 = new THREE.Matrix4();
@@ -18,24 +24,18 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
   // refraction: what SHRefractionLoaderPlugin read (result.userData.shRefraction.refractions[i]);
   // environment: an environment it read (from this file or an environment-only one).
   constructor({
-    refraction, environment = null, shading = 'jitter', order = -1, spreadScale = 0.15,
+    refraction, environment = null, shading = 'auto', order = -1, spreadScale = 0.15,
     footprintScale = 0.15, jitterCell = 0.005, blendSigma = 0.1, errorModel = true,
     toneMap = true, exposure = 1.0, absorption = null, bakeFromLocal = null,
   } = {}) {
     if (!refraction) throw new Error('SHRefractionMaterial: no refraction');
     const r = refraction;
-    const maxCount = r.coefficientCount;
-    const scale = new Float32Array(4 * maxCount), offset = new Float32Array(4 * maxCount);
-    // UNORM texels are code / 255: the scale per code times 255, as the C++ runtime's uniforms.
-    for (let i = 0; i < 4 * maxCount; ++i) {
-      scale[i] = r.scale[i] * 255;
-      offset[i] = r.offset[i];
-    }
     const pages = r.pages.length;
     const useError = !!(errorModel && r.error);
     // Room for the SH through the weights' order and the error model's, whichever is larger.
     const maxOrder = Math.max(r.order, useError ? r.error.order : 0);
     const defines = { SHREFRACT_SH_MAX_ORDER: maxOrder, SHREFRACT_WEIGHT_PAGES: pages };
+    if (r.basis === 'grid') [defines.SHREFRACT_GRID_THETA, defines.SHREFRACT_GRID_PHI] = r.grid;
     if (useError) defines.SHREFRACT_ERROR_MODEL = '';
     const uniforms = {
       uBakeFromLocal: { value: new THREE.Matrix4() },
@@ -50,8 +50,7 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
       uTileSize: { value: new THREE.Vector2(r.tileSize[0], r.tileSize[1]) },
       uTilesPerRow: { value: r.tilesPerRow },
       uTilesPerPage: { value: r.tilesPerPage },
-      uWeightScale: { value: scale },
-      uWeightOffset: { value: offset },
+      uWeightRange: { value: r.weightRange },
       uErrors: { value: r.error ? r.error.texture : null },
       uErrorOrder: { value: r.error ? r.error.order : 0 },
       uErrorOffset: { value: r.error ? r.error.offset : 0.01 },
@@ -111,10 +110,11 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
     u.uKappa.value.set(kappa[0], kappa[1], kappa[2]);
     u.uToneMap.value = !!this.toneMap;
     u.uExposure.value = this.exposure;
-    u.uSpread.value = this.shading !== 'sharp';
     u.uSpreadScale.value = this.spreadScale;
-    u.uBlendSigma.value = this.shading === 'blend' ? this.blendSigma : 0;
-    u.uJitterCell.value = this.shading === 'jitter' ? this.jitterCell * r.boundsDiagonal : 0;
+    const shading = resolveShading(this.shading, r);
+    u.uSpread.value = shading !== 'sharp';
+    u.uBlendSigma.value = shading === 'blend' ? this.blendSigma : 0;
+    u.uJitterCell.value = shading === 'jitter' ? this.jitterCell * r.boundsDiagonal : 0;
     u.uFootprintScale.value = this.footprintScale;
     setEnvironmentUniforms(u, this.environment);
     this.uniformsNeedUpdate = true;

@@ -15,16 +15,21 @@ export const SIZE = 256;
 // shrefract-render's orbit: azimuth, elevation (degrees), distance.
 export const VIEWS = [[30, 20, 3], [150, -10, 3], [270, 45, 2.5]];
 
-// CI: a few thousand samples each, seconds to bake. Full: the issue's objects at the paper's
-// settings (35k samples, 2048 directions, order 8).
+// CI: a few thousand samples each, seconds to bake; two SH bakes and a grid-basis one. Full: the
+// issue's objects at the paper's settings (35k samples, 2048 directions, order 8), and the bunny
+// in the grid basis.
 const SMALL = {
   knot1: ['data/meshes/knot1.off', '--rate', '1', '--order', '4', '--grid', '8x16'],
   teapot: ['data/scenes/teapot.json', '--rate', '2', '--order', '4', '--grid', '8x16'],
+  // The grid basis (version 2 of the extension): the traced 8 x 16 exits, its error model.
+  knot1_grid: ['data/meshes/knot1.off', '--rate', '1', '--basis', 'grid', '--grid', '8x16'],
 };
 const FULL = {
   bunny00: ['data/meshes/bunny00.off', '--samples', '35000', '--order', '8', '--grid', '32x64'],
   knot1: ['data/meshes/knot1.off', '--samples', '35000', '--order', '8', '--grid', '32x64'],
   teapot: ['data/scenes/teapot.json', '--samples', '35000', '--order', '8', '--grid', '32x64'],
+  // The grid basis the chart prefers (docs/bake.md "The grid basis"): 2048 bytes a sample.
+  bunny00_grid: ['data/meshes/bunny00.off', '--samples', '35000', '--basis', 'grid', '--grid', '16x32'],
 };
 
 // The glTF round trip (issue 20): scenes the bake reads as glTF, written back with

@@ -1,5 +1,5 @@
 // Bad files: a truncated GLB, a weight page that names a missing texture, a wrong extension
-// version. Each must put a clear message in the page's error element and raise no uncaught
+// version, a grid basis without its grid, a grid basis in a version 1 file. Each must put a clear message in the page's error element and raise no uncaught
 // exception, also with the live render loop running (no static=1).
 //   node bad-assets.test.js --assets DIR
 import { basename, join } from 'node:path';
@@ -19,13 +19,23 @@ const missing = readGlb(good);
 missing.json.extensions.SHREFRACT_sh_refraction.refractions[0].weights[0] = 99;
 writeGlb(join(dir, 'bad-missing-texture.glb'), missing);
 const version = readGlb(good);
-version.json.extensions.SHREFRACT_sh_refraction.version = 2;
+version.json.extensions.SHREFRACT_sh_refraction.version = 3;
 writeGlb(join(dir, 'bad-version.glb'), version);
+const gridGlb = Object.values(assets.objects).find((o) => readGlb(o.glb).json.extensions.SHREFRACT_sh_refraction
+  .refractions[0].basis === 'grid').glb;
+const noGrid = readGlb(gridGlb);
+delete noGrid.json.extensions.SHREFRACT_sh_refraction.refractions[0].grid;
+writeGlb(join(dir, 'bad-no-grid.glb'), noGrid);
+const gridInOne = readGlb(gridGlb);
+gridInOne.json.extensions.SHREFRACT_sh_refraction.version = 1;
+writeGlb(join(dir, 'bad-grid-in-version-1.glb'), gridInOne);
 
 const cases = [
   ['bad-truncated.glb', /truncated/],
   ['bad-missing-texture.glb', /weights\[0\] names texture 99, which the file lacks/],
-  ['bad-version.glb', /SHREFRACT_sh_refraction: version 2; this loader reads version 1 only/],
+  ['bad-version.glb', /SHREFRACT_sh_refraction: version 3; this loader reads versions 1 and 2/],
+  ['bad-no-grid.glb', /a grid basis needs "grid": \[nTheta, nPhi\].*it has undefined/],
+  ['bad-grid-in-version-1.glb', /basis "grid" \(version 1 knows "sh"\)/],
 ];
 await withBrowser(dir, {}, async (browser, base) => {
   let failed = false;

@@ -36,10 +36,12 @@ const FULL = {
 // shrefract-export --into. glass: primitives that get the material; others: primitives that keep
 // their own; compare: glass-only scenes, drawn by shrefract-render too.
 // camera: an orbit (azimuth, elevation, distance) around target, framing the glass (the Blender-
-// style scenes are in metres, away from the origin).
+// style scenes are in metres, away from the origin). bake: options instead of ROUND_TRIP_BAKE.
 const ROUND_TRIPS = {
   mug_water: { input: 'data/scenes/mug_water.gltf', glass: 2, others: 0, compare: true,
                camera: [30, 20, 3], target: [0, 0, 0] },
+  mug_water_grid: { input: 'data/scenes/mug_water.gltf', glass: 2, others: 0, compare: true,
+                    camera: [30, 20, 3], target: [0, 0, 0], bake: ['--rate', '1', '--basis', 'grid', '--grid', '8x16'] },
   blender_tumbler: { input: 'data/scenes/blender_tumbler.glb', glass: 2, others: 0, compare: true,
                      camera: [30, 20, 0.45], target: [0.2, 0.85, -0.1] },
   blender_glass_on_table: { input: 'data/scenes/blender_glass_on_table.gltf', glass: 1, others: 1,
@@ -98,7 +100,7 @@ export function makeAssets({ bin, out, full = false, fresh = false, log = () => 
     const exr = join(out, `${name}.shrefract.exr`), glb = join(out, `${name}_baked.glb`);
     if (!existsSync(exr)) {
       log(`baking ${name}`);
-      run(bake, [join(root, r.input), '-o', exr, ...ROUND_TRIP_BAKE, '--precision', 'u8', '-q', '--cache', join(out, 'cache')]);
+      run(bake, [join(root, r.input), '-o', exr, ...(r.bake ?? ROUND_TRIP_BAKE), '--precision', 'u8', '-q', '--cache', join(out, 'cache')]);
     }
     if (!existsSync(glb)) run(exporter, [exr, '--into', join(root, r.input), '-o', glb]);
     const view = { camera: r.camera, target: r.target, png: join(out, `${name}-view0.png`) };

@@ -131,15 +131,29 @@ class Tools:
             self.log("baked %s in %.0f s" % (tag, seconds))
         return out
 
+    def render_key(self, method):
+        """What a kept render depends on beyond its tag. The GL methods: the renderer itself (a hash
+        of the shrefract-render binary, which holds the runtime and its shaders), so that a changed
+        shader or runtime default never reuses a stale image. The ray tracer: its options and their
+        defaults (shrefract-render --help), so that the expensive references outlive work on the
+        runtime; a change to the reference tracer's code needs an empty work folder."""
+        if not hasattr(self, "_render_keys"):
+            with open(self.exe["render"], "rb") as f:
+                binary = hashlib.sha256(f.read()).hexdigest()[:10]
+            options = hashlib.sha256(self.run([self.exe["render"], "--help"]).encode()).hexdigest()[:10]
+            self._render_keys = {"gl": binary, "raytrace": options}
+        return self._render_keys["raytrace" if method == "raytrace" else "gl"]
+
     def render(self, bake, tag, camera, env="courtyard", method="sh", extra=(), size=None, reuse=False,
                spp=None):
         """Renders one evaluation buffer; returns its path, ms per frame and GPU memory (MB).
         `env`: a name in data/envmaps or a path. `reuse`: keep a render (and its log) that the
-        work folder already has, e.g. a reference, whose tag must then name all it depends on.
+        work folder already has, e.g. a reference, whose tag must then name the bake, camera and
+        options it depends on (render_key adds the renderer's part).
         `spp`: the ray tracer's samples per pixel (default: --spp)."""
         size = size or self.args.size
         spp = self.args.spp if spp is None else spp
-        out = os.path.join(self.work, "renders", tag + ".exr")
+        out = os.path.join(self.work, "renders", "%s-%s.exr" % (tag, self.render_key(method)))
         log, summary = out + ".log", out + ".json"
         if not (reuse and all(os.path.exists(p) for p in (out, log, summary))):
             envPath = env if os.path.sep in env else os.path.join(ROOT, "data", "envmaps", env + ".exr")

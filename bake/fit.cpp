@@ -63,24 +63,38 @@ std::string FitWeighting::ToString() const {
     return os.str();
 }
 
-WeightedFitter::WeightedFitter(const DirectionGrid& grid, int order, const FitWeighting& weighting)
-    : grid_(grid), weighting_(weighting) {
+namespace {
+
+// The order-L functions at the grid directions (J x K, even order).
+Eigen::MatrixXf shAtGrid(const DirectionGrid& grid, int order) {
     const int K = shEvenCount(order), J = grid.count();
-    SHREFRACT_CHECK(J >= K);
-    Y_.resize(J, K);
-    a_.resize(J);
+    Eigen::MatrixXf Y(J, K);
     const std::vector<ShLM> fs = shEvenFunctions(order);
     std::vector<double> all(shCount(order));
-    const double dTheta = 0.5 * M_PI / grid.nTheta, dPhi = 2.0 * M_PI / grid.nPhi;
     for (int j = 0; j < J; ++j) {
         shEvalAllRecurrence(order, grid.direction(j), all.data());
-        for (int k = 0; k < K; ++k) Y_(j, k) = float(all[shIndex(fs[k].l, fs[k].m)]);
-        const int i = j / grid.nPhi;  // cell solid angle: dPhi (cos theta_lo - cos theta_hi)
-        a_(j) = float(dPhi * (std::cos(i * dTheta) - std::cos((i + 1) * dTheta)));
+        for (int k = 0; k < K; ++k) Y(j, k) = float(all[shIndex(fs[k].l, fs[k].m)]);
     }
+    return Y;
+}
+
+}  // namespace
+
+WeightedFitter::WeightedFitter(const DirectionGrid& grid, int order, const FitWeighting& weighting)
+    : WeightedFitter(grid, shAtGrid(grid, order), weighting) {
+    const std::vector<ShLM> fs = shEvenFunctions(order);
+    for (int k = 0; k < coefficients(); ++k) ridge_(k) = weighting.ridge * float(fs[k].l * (fs[k].l + 1));
+}
+
+WeightedFitter::WeightedFitter(const DirectionGrid& grid, Eigen::MatrixXf basisAtGrid,
+                               const FitWeighting& weighting)
+    : grid_(grid), weighting_(weighting), Y_(std::move(basisAtGrid)) {
+    const int J = grid.count(), K = int(Y_.cols());
+    SHREFRACT_CHECK(Y_.rows() == J && J >= K);
+    const std::vector<double> a = gridSolidAngles(grid);
+    a_ = Eigen::Map<const Eigen::VectorXd>(a.data(), J).cast<float>();
     Gall_ = Y_.transpose() * a_.asDiagonal() * Y_;
-    ridge_.resize(K);
-    for (int k = 0; k < K; ++k) ridge_(k) = weighting.ridge * float(fs[k].l * (fs[k].l + 1));
+    ridge_ = Eigen::VectorXf::Zero(K);
 }
 
 void WeightedFitter::confidence(const PathResult* paths, float* c) const {

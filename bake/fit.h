@@ -70,6 +70,9 @@ struct FitWeighting {
 class WeightedFitter {
 public:
     WeightedFitter(const DirectionGrid& grid, int order, const FitWeighting& weighting);
+    // Any other functions, given by their values at the grid directions (J x K; `ridge` is
+    // ignored: it is defined by the SH bands): the learned basis of shrefract-fit-study.
+    WeightedFitter(const DirectionGrid& grid, Eigen::MatrixXf basisAtGrid, const FitWeighting& weighting);
     int coefficients() const { return int(Y_.cols()); }
     int directions() const { return int(Y_.rows()); }
     // c_j of one sample's J paths from their flags and exits (before any trim pass), into c[0..J).

@@ -324,12 +324,17 @@ Eigen::MatrixXd compressionMatrix(const DirectionGrid& grid, int L, int q) {
     return M;
 }
 
+std::vector<double> gridSolidAngles(const DirectionGrid& grid) {
+    std::vector<double> a(grid.count());
+    for (int j = 0; j < grid.count(); ++j) a[j] = cellSolidAngle(grid, j / grid.nPhi);
+    return a;
+}
+
 Eigen::MatrixXd leastSquaresMatrix(const DirectionGrid& grid, int L) {
     checkGrid(grid);
     std::vector<glm::dvec3> dirs(grid.count());
-    std::vector<double> a(grid.count());
-    for (int j = 0; j < grid.count(); ++j) dirs[j] = grid.direction(j), a[j] = cellSolidAngle(grid, j / grid.nPhi);
-    return leastSquaresMatrix(dirs, a, L);
+    for (int j = 0; j < grid.count(); ++j) dirs[j] = grid.direction(j);
+    return leastSquaresMatrix(dirs, gridSolidAngles(grid), L);
 }
 
 Eigen::MatrixXd leastSquaresMatrix(const std::vector<glm::dvec3>& dirs, const std::vector<double>& solidAngle, int L) {

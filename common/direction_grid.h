@@ -30,6 +30,9 @@ struct DirectionGrid {
     int interpolate(glm::dvec3 w, int index[4], double weight[4]) const;
     std::string ToString() const;  // "32x64"
 };
+// The solid angle each grid direction stands for, its (theta, phi) cell: dPhi (cos theta_lo -
+// cos theta_hi). They sum to 2 pi over the hemisphere.
+std::vector<double> gridSolidAngles(const DirectionGrid& grid);
 // What is wrong with a grid, or "" when it is usable: counts in [limits::kMinGrid, kMaxGrid], nPhi
 // even. The one check for --grid and for a bake file's manifest.
 std::string gridProblem(int nTheta, int nPhi);

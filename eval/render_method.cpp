@@ -110,12 +110,12 @@ void RenderMethod::Impl::setUpSh(const Camera& camera, nlohmann::json& summary) 
     const bool joining = bake.layout() == "joining";
     std::printf("bake: %s, %d samples, %d triangles, %s layout, %s %dx%d; using "
                 "order %d, %d decompression pass(es), preset %s, path %s, decompression %s, "
-                "shading %s; GPU memory %.2f MB\n",
+                "shading %s, %d tap(s); GPU memory %.2f MB\n",
                 bakeData(bake).modelName().c_str(), bake.sampleCount(), bake.triangleCount(), bake.layout().c_str(),
                 joining ? "rho" : "atlas", refractor->refractionMapSize().x,
                 refractor->refractionMapSize().y, refractor->order(), refractor->passCount(),
                 nameOf(options.preset), nameOf(refractor->path()), nameOf(refractor->decompression()),
-                nameOf(refractor->shading()), refractor->memory().total() / 1e6);
+                nameOf(refractor->shading()), refractor->taps(), refractor->memory().total() / 1e6);
     if (!joining)
         std::printf("charts: gutter %d texels, seam-aware %s\n", refractor->gutter(),
                     refractor->seamAware() ? "on" : "off");
@@ -124,6 +124,7 @@ void RenderMethod::Impl::setUpSh(const Camera& camera, nlohmann::json& summary) 
     summary["path"] = nameOf(refractor->path());
     summary["decompression"] = nameOf(refractor->decompression());
     summary["shading"] = nameOf(refractor->shading());
+    summary["taps"] = refractor->taps();
     if (!r.dumpDir.empty()) refractor->dumpShaders(r.dumpDir);
     if (!joining) {  // the map's own jump across the seams
         refractor->update(FrameView::fromEye(camera.eye));

@@ -31,6 +31,7 @@ uniform float uJitterCell;      // > 0 (jitter shading): one direction drawn wit
                                 // cell of this size (object units), instead of the lobe's mean;
                                 // oDirection keeps the bake's exit (what the metrics measure)
 uniform float uFootprintScale;  // factor on the screen-space turn of a direction per pixel
+uniform int uTaps;              // 1: one lookup at the pixel's centre; 4: four inside it, averaged
 in vec3 vPosition;
 in vec3 vObjectPosition;
 in vec3 vNormal;
@@ -39,14 +40,9 @@ layout(location = 0) out vec4 oColor;
 layout(location = 1) out vec4 oDirection;
 #endif
 
-void main() {
-#ifdef SHREFRACT_DIRECT
-    vec4 r = vD;
-#else
-    vec4 r = texture(uRho, vUV);
-#endif
-    vec3 v = normalize(uEye - vPosition);
-    vec3 n = normalize(vNormal);
+// The colour of one lookup: the interpolated D (xyz its direction, w the path length) at an
+// object-space point, shaded as the uniforms ask.
+vec3 shadeOne(vec4 r, vec3 objectPosition, vec3 n, vec3 v) {
     // A (near) zero interpolated direction has no direction: go straight through, never NaN.
     float resultant = length(r.xyz);
     vec3 exitWorld = resultant > 1e-10 ? normalize(uModelRotation * (r.xyz / resultant)) : -v;
@@ -54,7 +50,7 @@ void main() {
     float reflectSigma = 0.0, spread = 0.0;
     if (uSpread) {
         spread = spreadSigma(resultant, uSpreadScale);
-        lookup = transmissionLookup(exitWorld, spread, uFootprintScale, uJitterCell, vObjectPosition);
+        lookup = transmissionLookup(exitWorld, spread, uFootprintScale, uJitterCell, objectPosition);
         reflectSigma = footprintSigma(reflect(-v, n), uFootprintScale);
     }
     vec3 c = shadeGlass(lookup.xyz, lookup.w, r.w, n, v, uEta, uKappa, reflectSigma);
@@ -65,8 +61,39 @@ void main() {
         vec3 sharp = shadeGlass(exitWorld, sharpSigma, r.w, n, v, uEta, uKappa, reflectSigma);
         c = mix(sharp, c, spread / (spread + uBlendSigma));
     }
+    return c;
+}
+
+void main() {
+#ifdef SHREFRACT_DIRECT
+    vec4 r = vD;
+#else
+    vec4 r = texture(uRho, vUV);
+#endif
+    vec3 v = normalize(uEye - vPosition);
+    vec3 c;
+    if (uTaps == 4) {
+        // Four lookups at (+-1/4, +-1/4) pixel, all that is interpolated (D, the point, the
+        // normal) carried there along its screen derivatives, averaged: the exit's pattern
+        // antialiased inside the pixel. uTaps is uniform: the derivatives are taken in uniform
+        // control flow.
+        vec4 rx = 0.25 * dFdx(r), ry = 0.25 * dFdy(r);
+        vec3 px = 0.25 * dFdx(vPosition), py = 0.25 * dFdy(vPosition);
+        vec3 ox = 0.25 * dFdx(vObjectPosition), oy = 0.25 * dFdy(vObjectPosition);
+        vec3 nx = 0.25 * dFdx(vNormal), ny = 0.25 * dFdy(vNormal);
+        c = vec3(0.0);
+        for (int i = 0; i < 4; ++i) {
+            float sx = (i & 1) == 0 ? -1.0 : 1.0, sy = i < 2 ? -1.0 : 1.0;
+            c += 0.25 * shadeOne(r + sx * rx + sy * ry, vObjectPosition + sx * ox + sy * oy,
+                                 normalize(vNormal + sx * nx + sy * ny),
+                                 normalize(uEye - (vPosition + sx * px + sy * py)));
+        }
+    } else {
+        c = shadeOne(r, vObjectPosition, normalize(vNormal), v);
+    }
     oColor = vec4(uToneMap ? toneMap(c, uExposure) : c, 1.0);
 #ifndef SHREFRACT_COLOR_ONLY
-    oDirection = vec4(exitWorld, 1.0);
+    float resultant = length(r.xyz);
+    oDirection = vec4(resultant > 1e-10 ? normalize(uModelRotation * (r.xyz / resultant)) : -v, 1.0);
 #endif
 }

@@ -95,6 +95,12 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
     // the bake is unsure": scripts/compare's chart).
     if (options.shading == Shading::Auto)
         m->options.shading = d.basis == Basis::Grid ? Shading::Blend : Shading::Jitter;
+    if (options.taps != -1 && options.taps != 1 && options.taps != 4)
+        throw std::invalid_argument("shrefract: RefractorOptions taps " + std::to_string(options.taps) +
+                                    ": 1, 4 or -1 (by the bake's basis)");
+    // Four taps on a grid-basis bake: its sharper exits alias where SH's low-pass does not
+    // (docs/runtime.md "Four taps": scripts/compare's chart).
+    if (options.taps == -1) m->options.taps = d.basis == Basis::Grid ? 4 : 1;
     GLint units = 16;
     glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &units);
     const PipelineInputs in{bake,        m->options,         m->settings, m->maxOrder,
@@ -180,6 +186,7 @@ void Refractor::draw(const Environment& environment) {
     glUniform1f(glGetUniformLocation(p, "uJitterCell"),
                 o.shading == Shading::Jitter ? o.jitterCell * m.diagonal : 0.0f);
     glUniform1f(glGetUniformLocation(p, "uFootprintScale"), o.footprintScale);
+    glUniform1i(glGetUniformLocation(p, "uTaps"), o.taps);
     useEnvironment(p, environment, 0);
     if (ior)
         m.ior.setUniforms(p, m.bake.ior(), m.ior.bracket ? m.ior.bracket->impl_->bake.ior() : 0.0f);
@@ -227,6 +234,7 @@ glm::ivec2 Refractor::refractionMapSize() const { return impl_->pipeline->refrac
 RefractorPath Refractor::path() const { return impl_->pipeline->path(); }
 DecompressionSite Refractor::decompression() const { return impl_->pipeline->decompressionSite(); }
 Shading Refractor::shading() const { return impl_->options.shading; }
+int Refractor::taps() const { return impl_->options.taps; }
 
 void Refractor::setOrder(int L) {
     // As RefractorOptions::order: -1 is every uploaded band, above maxOrder clamps to it.

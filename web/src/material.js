@@ -15,6 +15,14 @@ export function resolveShading(shading, refraction) {
   return refraction.basis === 'grid' ? 'blend' : 'jitter';
 }
 
+// Taps -1: the lookups per pixel measured best for the bake's basis, as the C++ Refractor's
+// (docs/runtime.md "Four taps"): 4 on a grid, 1 on SH.
+export function resolveTaps(taps, refraction) {
+  if (taps === -1) return refraction.basis === 'grid' ? 4 : 1;
+  if (taps !== 1 && taps !== 4) throw new Error(`SHRefractionMaterial: taps ${taps}: 1, 4 or -1 (by the bake's basis)`);
+  return taps;
+}
+
 const _m3 = new THREE.Matrix3();
 const _m4 = new THREE.Matrix4();
 const _v3 = new THREE.Vector3();
@@ -25,7 +33,7 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
   // environment: an environment it read (from this file or an environment-only one).
   constructor({
     refraction, environment = null, shading = 'auto', order = -1, spreadScale = 0.15,
-    footprintScale = 0.15, jitterCell = 0.005, blendSigma = 0.1, errorModel = true,
+    footprintScale = 0.15, taps = -1, jitterCell = 0.005, blendSigma = 0.1, errorModel = true,
     toneMap = true, exposure = 1.0, absorption = null, bakeFromLocal = null,
   } = {}) {
     if (!refraction) throw new Error('SHRefractionMaterial: no refraction');
@@ -63,6 +71,7 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
       uBlendSigma: { value: 0 },
       uJitterCell: { value: 0 },
       uFootprintScale: { value: footprintScale },
+      uTaps: { value: 1 },
       ...environmentUniforms(),
     };
     r.pages.forEach((t, p) => { uniforms[`uWeightPage${p}`] = { value: t }; });
@@ -79,6 +88,7 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
     this.order = order;
     this.spreadScale = spreadScale;
     this.footprintScale = footprintScale;
+    this.taps = taps;
     this.jitterCell = jitterCell;
     this.blendSigma = blendSigma;
     this.toneMap = toneMap;
@@ -116,6 +126,7 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
     u.uBlendSigma.value = shading === 'blend' ? this.blendSigma : 0;
     u.uJitterCell.value = shading === 'jitter' ? this.jitterCell * r.boundsDiagonal : 0;
     u.uFootprintScale.value = this.footprintScale;
+    u.uTaps.value = resolveTaps(this.taps, r);
     setEnvironmentUniforms(u, this.environment);
     this.uniformsNeedUpdate = true;
   }

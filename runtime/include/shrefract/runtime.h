@@ -214,6 +214,11 @@ struct RefractorOptions {
     // object's bounding-box diagonal; about two pixels where the object spans 400), the same in
     // every frame, instead of the lobe's mean (docs/runtime.md "Jitter shading").
     float jitterCell = 0.005f;
+    // Lookups per pixel, averaged: 1 at its centre, or 4 at (+-1/4, +-1/4) pixel, which
+    // antialiases the exit's pattern inside the pixel (docs/runtime.md "Four taps"). -1: the
+    // measured default for the bake's basis, 4 on a grid-basis bake and 1 on SH; taps() tells.
+    // Others: std::invalid_argument. Variable-IOR frames (setIor) take one.
+    int taps = -1;
     // Spread shading takes the lobe width from the bake's error model, its predicted angular error
     // at each sample and view direction, where the bake has one (format version 3; docs/runtime.md
     // "Error model"); off, or on older bakes, from the SH reconstruction's length alone. Applies
@@ -268,6 +273,7 @@ public:
     RefractorPath path() const;               // Rho, Direct, or Charts for chart bakes
     DecompressionSite decompression() const;  // Texture or Vertex
     Shading shading() const;                  // as RefractorOptions::shading, Auto resolved
+    int taps() const;                         // as RefractorOptions::taps, -1 resolved
     // Progressive decompression (paper §6): use bands 0..L, as RefractorOptions::order does:
     // -1 is all uploaded bands, above maxOrder clamps to it, below -1 is std::invalid_argument.
     void setOrder(int L);

@@ -40,12 +40,18 @@ layout(location = 0) out vec4 oColor;
 layout(location = 1) out vec4 oDirection;
 #endif
 
+// The world-space exit of an interpolated D seen along v. A (near) zero D has no direction: go
+// straight through, never NaN.
+vec3 exitOf(vec4 r, vec3 v) {
+    float resultant = length(r.xyz);
+    return resultant > 1e-10 ? normalize(uModelRotation * (r.xyz / resultant)) : -v;
+}
+
 // The colour of one lookup: the interpolated D (xyz its direction, w the path length) at an
 // object-space point, shaded as the uniforms ask.
 vec3 shadeOne(vec4 r, vec3 objectPosition, vec3 n, vec3 v) {
-    // A (near) zero interpolated direction has no direction: go straight through, never NaN.
     float resultant = length(r.xyz);
-    vec3 exitWorld = resultant > 1e-10 ? normalize(uModelRotation * (r.xyz / resultant)) : -v;
+    vec3 exitWorld = exitOf(r, v);
     vec4 lookup = vec4(exitWorld, 0.0);
     float reflectSigma = 0.0, spread = 0.0;
     if (uSpread) {
@@ -93,7 +99,6 @@ void main() {
     }
     oColor = vec4(uToneMap ? toneMap(c, uExposure) : c, 1.0);
 #ifndef SHREFRACT_COLOR_ONLY
-    float resultant = length(r.xyz);
-    oDirection = vec4(resultant > 1e-10 ? normalize(uModelRotation * (r.xyz / resultant)) : -v, 1.0);
+    oDirection = vec4(exitOf(r, v), 1.0);
 #endif
 }

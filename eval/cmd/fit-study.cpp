@@ -141,6 +141,8 @@ int main(int argc, char** argv) {
                 omega[size_t(s) * D + d] = {r * std::cos(phi), r * std::sin(phi), z};
             }
         }
+        // The default weighting's c_j: what the learned bases are learned and fitted with.
+        const WeightedFitter defaultConfidence(grid, order, FitWeighting{});
         // Sample i's paths along the J grid directions, into out[0..J).
         auto traceGrid = [&](int i, PathResult* out) {
             const Frame f = Frame::fromNormal(L.normal[i]);
@@ -175,13 +177,12 @@ int main(int argc, char** argv) {
                 enableFlushToZero();
                 traceGrid(learnSample[s], &learnPaths[size_t(s) * J]);
             });
-            const WeightedFitter confidence(grid, order, FitWeighting{});
             if (Kmax > 0) {
-                LearnedBasis b = learnScalarBasis(learnPaths, grid, confidence, Kmax);
+                LearnedBasis b = learnScalarBasis(learnPaths, grid, defaultConfidence, Kmax);
                 learnedBasis = std::move(b.values), learnedEnergy = std::move(b.energy);
             }
             if (KVmax > 0) {
-                LearnedBasis b = learnVectorBasis(learnPaths, grid, confidence, learnFrames, KVmax);
+                LearnedBasis b = learnVectorBasis(learnPaths, grid, defaultConfidence, learnFrames, KVmax);
                 learnedVectorBasis = std::move(b.values), learnedVectorEnergy = std::move(b.energy);
             }
             auto say = [&](const char* what, const std::vector<int>& ks, const std::vector<double>& energy) {
@@ -217,7 +218,6 @@ int main(int argc, char** argv) {
             variants.push_back(v);
         }
         const Eigen::MatrixXf M = compressionMatrix(grid, order).cast<float>();
-        const WeightedFitter confidenceOnly(grid, order, FitWeighting{});  // c_j for the vector fits
         const Eigen::MatrixXf Mlsq = leastSquaresMatrix(grid, order).cast<float>();
 
         nlohmann::json report = {{"mesh", mesh}, {"order", order}, {"grid", gridText}, {"studySamples", S},
@@ -261,7 +261,7 @@ int main(int argc, char** argv) {
                 if (v.kind == Variant::Learned) Rlearned = learnedBasis.leftCols(v.learned) * W;
                 if (v.kind == Variant::LearnedVector) {
                     std::vector<float> cj(J);
-                    confidenceOnly.confidence(paths, cj.data());
+                    defaultConfidence.confidence(paths, cj.data());
                     Rlearned = fitVectorBasis(learnedVectorBasis.leftCols(v.learned), R, grid, cj, v.weighting);
                 }
                 SplitModel split;

@@ -38,7 +38,7 @@ int main(int argc, char** argv) {
     double targetError = 0;
     std::string targetReport;
     app.add_option("input", input, "mesh (.obj .off .ply .stl), scene (.json) or glTF (.gltf .glb)")->required();
-    app.add_option("-o,--output", output, "output file, NAME.shrefract.exr")->required();
+    auto* outputOpt = app.add_option("-o,--output", output, "output file, NAME.shrefract.exr (required unless --search-only)");
     std::string basis = nameOf(opt.basis);
     app.add_option("--basis", basis,
                    "sh: fit each sample's directions with SH (the paper); grid: store the traced "
@@ -105,6 +105,11 @@ int main(int argc, char** argv) {
                    "--order, --rate, --grid; a given --basis or --precision limits the search to it)")
         ->check(CLI::PositiveNumber)->excludes("--target-error");
     app.add_option("--target-report", targetReport, "write the --target-error or --budget search as JSON");
+    bool searchOnly = false;
+    app.add_flag("--search-only", searchOnly,
+                 "with --target-error or --budget: print the choice and the options that bake it "
+                 "(and write --target-report), then stop; no -o, nothing baked")
+        ->excludes(outputOpt);
     std::string shardText, workDir, tracer = "coherent";
     int checkpoints = 0;
     bool resume = false;
@@ -144,6 +149,8 @@ int main(int argc, char** argv) {
                 throw InputError("--texels is for --layout isolated or uv");
             const bool search = targetError > 0 || budgetMB > 0;
             const char* searchFlag = targetError > 0 ? "--target-error" : "--budget";
+            if (searchOnly && !search) throw InputError("--search-only needs --target-error or --budget");
+            if (output.empty() && !searchOnly) throw InputError("-o,--output is required");
             if (opt.layout != LayoutKind::Joining && search)
                 throw InputError(str(searchFlag, " searches joining layouts only"));
             if (!texels.empty()) {
@@ -174,7 +181,7 @@ int main(int argc, char** argv) {
             // Every output checked and staged before the work: a bad path fails now, not after an
             // hour of tracing, and nothing appears under its name until all are complete.
             OutputSet outputs;
-            const std::string stagedBake = outputs.add(output);
+            const std::string stagedBake = searchOnly ? "" : outputs.add(output);
             const std::string stagedReport = targetReport.empty() ? "" : outputs.add(targetReport);
 
             Medium medium;
@@ -214,7 +221,15 @@ int main(int argc, char** argv) {
                 std::printf("  chosen: %.2fx less memory, %.2fx less tracing\n",
                             double(p.weightBytes) / std::max<size_t>(1, c.weightBytes),
                             p.bakeCost / std::max(1.0, c.bakeCost));
+                // The options that bake the choice, to paste after the input and -o.
+                std::printf("  bake it with: --basis %s%s --rate %d --grid %s --precision %s\n", nameOf(c.basis),
+                            c.basis == Basis::Sh ? str(" --order ", c.order).c_str() : "", c.rate,
+                            c.grid.ToString().c_str(), nameOf(c.precision));
                 if (!targetReport.empty()) writeFile(stagedReport, t.ToJson().dump(2) + "\n");
+                if (searchOnly) {
+                    outputs.commit();
+                    return int(cli::kOk);
+                }
                 opt.basis = c.basis;
                 opt.order = c.order;
                 opt.rate = c.rate;

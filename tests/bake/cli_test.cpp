@@ -9,6 +9,9 @@
 #include <sstream>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
+#include "common/bakefile.h"
 #include "support/cli_run.h"
 
 namespace {
@@ -146,6 +149,53 @@ TEST(BakeCli, RankDeficientWeightedFitStillBakes) {
                                 " --order 14 --grid 8x16 --samples 20 --cache '' -q");
     EXPECT_EQ(r.code, 0) << r.out;
     EXPECT_TRUE(fs::exists(out));
+}
+
+// --search-only: the search's choice and the options that bake it, and no bake. Round trip: the
+// printed options, given to a bake, make the model the report chose.
+TEST(BakeCli, SearchOnlyPrintsTheOptionsThatBakeItsChoice) {
+    write(tmp("search_tetra.off"), kTetra);
+    const std::string report = tmp("search_report.json");
+    fs::remove(report);
+    CommandResult r = run(kBake + " " + tmp("search_tetra.off") + " --budget 0.002 --search-only --target-report " +
+                          report + " --cache '' -q");
+    ASSERT_EQ(r.code, 0) << r.out;
+    const std::string lead = "bake it with: ";
+    const size_t at = r.out.find(lead);
+    ASSERT_NE(at, std::string::npos) << r.out;
+    const std::string options = r.out.substr(at + lead.size(), r.out.find('\n', at) - at - lead.size());
+    std::ifstream f(report);
+    ASSERT_TRUE(f) << "no report written";
+    const nlohmann::json chosen = nlohmann::json::parse(f)["chosen"];
+    EXPECT_LE(chosen["weightMB"].get<double>(), 0.002);
+
+    const std::string out = tmp("search_choice.shrefract.exr");
+    fs::remove(out);
+    r = run(kBake + " " + tmp("search_tetra.off") + " -o " + out + " " + options + " --cache '' -q");
+    ASSERT_EQ(r.code, 0) << options << "\n" << r.out;
+    const shrefract::BakeData b = shrefract::readBake(out);
+    EXPECT_EQ(shrefract::nameOf(b.basis), chosen["basis"].get<std::string>());
+    if (b.basis == shrefract::Basis::Sh) EXPECT_EQ(b.order, chosen["order"].get<int>());
+    EXPECT_EQ(b.layout.rate, chosen["rate"].get<int>());
+    EXPECT_EQ(b.grid.ToString(), chosen["grid"].get<std::string>());
+    EXPECT_EQ(shrefract::nameOf(b.precision), chosen["precision"].get<std::string>());
+
+    // With -o it is refused (CLI11's usage error), and neither file is written.
+    fs::remove(report);
+    r = run(kBake + " " + tmp("search_tetra.off") + " -o " + tmp("search_no.shrefract.exr") +
+            " --budget 0.002 --search-only --target-report " + report + " -q");
+    EXPECT_EQ(r.code, 2) << r.out;
+    EXPECT_NE(r.out.find("excludes"), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(report));
+    EXPECT_FALSE(fs::exists(tmp("search_no.shrefract.exr")));
+    // Without it, a bake needs -o.
+    r = run(kBake + " " + tmp("search_tetra.off") + " --budget 0.002 -q");
+    EXPECT_EQ(r.code, 2) << r.out;
+    EXPECT_NE(r.out.find("-o,--output is required"), std::string::npos) << r.out;
+    // And --search-only needs a search.
+    r = run(kBake + " " + tmp("search_tetra.off") + " --search-only -q");
+    EXPECT_EQ(r.code, 2) << r.out;
+    EXPECT_NE(r.out.find("--search-only needs --target-error or --budget"), std::string::npos) << r.out;
 }
 
 TEST(BakeCli, MissingOutputFolderIsAnErrorBeforeAnyWork) {

@@ -168,6 +168,7 @@ function coverage() {
   frame();
   return mask;
 }
-Object.assign(state, { THREE, renderer, scene, camera, background, readPixels, coverage, orbit, size: [width, height],
-                       get materials() { return materials; } });
+Object.assign(state, { THREE, renderer, scene, camera, background, readPixels, coverage, orbit, size: [width, height] });
+// A getter of its own: Object.assign would copy the empty list the page starts with.
+Object.defineProperty(state, 'materials', { get: () => materials, enumerable: true });
 main().catch(showError);

@@ -16,9 +16,6 @@
 #ifdef SHREFRACT_GRID_THETA
 #include "grid_eval.glsl"
 #endif
-#ifndef SHREFRACT_WEIGHT_PAGES
-#define SHREFRACT_WEIGHT_PAGES 1
-#endif
 in vec3 position;            // the sample's P, the primitive's coordinates
 in vec3 normal;              // its unit shading normal, likewise
 in float _shrefract_sample;  // which sample (exact in float below 2^24)
@@ -38,19 +35,7 @@ uniform int uTilesPerPage;
 // uWeightRange (scale x 255), as the C++ grid pass's uWeightRange (a grid's 512 coefficients
 // would overflow a uniform array).
 uniform highp sampler2D uWeightRange;
-uniform sampler2D uWeightPage0;
-#if SHREFRACT_WEIGHT_PAGES > 1
-uniform sampler2D uWeightPage1;
-#endif
-#if SHREFRACT_WEIGHT_PAGES > 2
-uniform sampler2D uWeightPage2;
-#endif
-#if SHREFRACT_WEIGHT_PAGES > 3
-uniform sampler2D uWeightPage3;
-#endif
-#if SHREFRACT_WEIGHT_PAGES > 4
-#error "web_shade.vert: at most 4 weight pages"
-#endif
+uniform highp sampler2DArray uWeightPages;  // layer p: atlas page p (web/src/material.js)
 #ifdef SHREFRACT_ERROR_MODEL
 uniform highp sampler2DArray uErrors;  // layer k: e_k per sample, red, laid out as a weight tile
 uniform int uErrorOrder;
@@ -65,16 +50,7 @@ vec4 weightTexel(int k, int i) {
     int page = k / uTilesPerPage, j = k - page * uTilesPerPage;
     ivec2 t = ivec2((j % uTilesPerRow) * uTileSize.x + i % uTileSize.x,
                     (j / uTilesPerRow) * uTileSize.y + i / uTileSize.x);
-#if SHREFRACT_WEIGHT_PAGES > 1
-    if (page == 1) return texelFetch(uWeightPage1, t, 0);
-#endif
-#if SHREFRACT_WEIGHT_PAGES > 2
-    if (page == 2) return texelFetch(uWeightPage2, t, 0);
-#endif
-#if SHREFRACT_WEIGHT_PAGES > 3
-    if (page == 3) return texelFetch(uWeightPage3, t, 0);
-#endif
-    return texelFetch(uWeightPage0, t, 0);
+    return texelFetch(uWeightPages, ivec3(t, page), 0);
 }
 
 // Coefficient k of sample i, decoded.

@@ -34,6 +34,11 @@ int main(int argc, char** argv) {
                    "whose glass primitives carry the bake, everything else as it was");
     app.add_option("--name", name, "the refraction's and the mesh's name (default: from the bake's file name)");
     app.add_flag("--no-verify", noVerify, "skip the bake's checksums");
+    int maxTexture = kMaxGltfTexture;
+    app.add_option("--max-texture", maxTexture,
+                   "the weight pages' largest side in texels: 4096 (phones), down to 2048 for "
+                   "any WebGL 2 (more, smaller pages)")
+        ->capture_default_str()->check(CLI::Range(16, 16384));
     return cli::run(app, "shrefract-export", argc, argv, [&] {
         if (bakePath.empty() && environments.empty())
             throw std::invalid_argument("nothing to export: give a bake, --environment, or both");
@@ -43,6 +48,7 @@ int main(int argc, char** argv) {
         OutputSet outputs;  // checked and staged before the work (common/output.h)
         const std::string staged = outputs.add(output);
         GltfExport what;
+        what.maxTexture = maxTexture;
         BakeData bake;
         if (!bakePath.empty()) {
             ReadOptions options;
@@ -64,7 +70,7 @@ int main(int argc, char** argv) {
         }
         std::vector<uint8_t> glb;
         if (!into.empty()) {
-            glb = exportInto(bake, into, what.environments);  // its errors name the scene
+            glb = exportInto(bake, into, what.environments, maxTexture);  // its errors name the scene
         } else {
             try {
                 glb = exportGlb(what);

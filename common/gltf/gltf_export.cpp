@@ -181,7 +181,7 @@ tinygltf::Primitive samplePrimitive(BinaryBuffer& bin, const SurfaceLayout& L,
 // The refraction's data: atlas pages as PNG images, scale and offset, the error model, the front
 // medium; its entry in the root extension.
 nlohmann::json addRefraction(tinygltf::Model& model, BinaryBuffer& bin, const BakeData& d,
-                             const std::string& name) {
+                             const std::string& name, int maxTexture) {
     const SurfaceLayout& L = d.layout;
     checkExportable(d);
     const size_t N = static_cast<size_t>(L.sampleCount());
@@ -189,7 +189,7 @@ nlohmann::json addRefraction(tinygltf::Model& model, BinaryBuffer& bin, const Ba
     const glm::vec3 kappa = frontAbsorption(d);
 
     // The weights: one PNG image and texture per atlas page, nearest filtering, no mipmaps.
-    const WeightAtlas atlas = weightAtlas(d);
+    const WeightAtlas atlas = weightAtlas(d, maxTexture);
     tinygltf::Sampler sampler;
     sampler.minFilter = TINYGLTF_TEXTURE_FILTER_NEAREST;
     sampler.magFilter = TINYGLTF_TEXTURE_FILTER_NEAREST;
@@ -336,7 +336,7 @@ std::vector<uint8_t> exportGlb(const GltfExport& what) {
     std::vector<std::string> used = {kExtension};
     nlohmann::json root = {{"version", kExtensionVersion}};
     if (what.bake) {
-        root["refractions"] = {addRefraction(model, bin, *what.bake, what.name)};
+        root["refractions"] = {addRefraction(model, bin, *what.bake, what.name, what.maxTexture)};
         // One node, one mesh: the whole sample grid, vertex v sample v, with a plain glass material.
         tinygltf::Primitive prim = samplePrimitive(bin, what.bake->layout, refinedTriangles(what.bake->layout), -1, glm::dmat4(1.0));
         prim.material = glassMaterial(model, frontIor(*what.bake), frontAbsorption(*what.bake), used);
@@ -405,7 +405,7 @@ void gatherIntoOneBuffer(tinygltf::Model& model) {
 }  // namespace
 
 std::vector<uint8_t> exportInto(const BakeData& bake, const std::string& scenePath,
-                                const std::vector<GltfEnvironment>& environments) {
+                                const std::vector<GltfEnvironment>& environments, int maxTexture) {
     checkExportable(bake);
     // The parts as the bake read them, and where each came from.
     tinygltf::Model model;
@@ -427,7 +427,7 @@ std::vector<uint8_t> exportInto(const BakeData& bake, const std::string& scenePa
 
     nlohmann::json root = {{"version", kExtensionVersion}};
     const std::string name = std::filesystem::path(scenePath).stem().string();
-    root["refractions"] = {addRefraction(model, bin, bake, name)};
+    root["refractions"] = {addRefraction(model, bin, bake, name, maxTexture)};
     // Each glass primitive becomes the sample grid of its part, in its node's coordinates, with
     // its own material. A mesh several glass nodes share is copied for each but the first.
     std::vector<int> meshUsers(model.meshes.size(), 0);

@@ -49,10 +49,11 @@ struct GltfExport {
     const BakeData* bake = nullptr;  // none: a file of environments only
     std::string name;                // the refraction's and the mesh's name
     std::vector<GltfEnvironment> environments;
+    int maxTexture = kMaxGltfTexture;  // the weight pages' largest side, texels
 };
 
 // The GLB file's bytes. Throws InputError for what a glTF file cannot hold (a chart layout, a
-// tile wider than kMaxGltfTexture) and std::invalid_argument for an empty export.
+// tile wider than maxTexture) and std::invalid_argument for an empty export.
 std::vector<uint8_t> exportGlb(const GltfExport& what);
 
 // The round trip (shrefract-export --into): the glTF scene the bake was made from (.gltf with its
@@ -62,6 +63,7 @@ std::vector<uint8_t> exportGlb(const GltfExport& what);
 // binary chunk, bytes unchanged). Throws InputError when the bake was not made from this scene
 // (part count or a mesh checksum differs) or the scene cannot be read.
 std::vector<uint8_t> exportInto(const BakeData& bake, const std::string& scenePath,
-                                const std::vector<GltfEnvironment>& environments = {});
+                                const std::vector<GltfEnvironment>& environments = {},
+                                int maxTexture = kMaxGltfTexture);
 
 }  // namespace shrefract

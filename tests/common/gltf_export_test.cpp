@@ -172,6 +172,34 @@ TEST(GltfExport, U8BakesKeepTheirCodesExactly) {
     EXPECT_EQ(mismatches, 0);
 }
 
+// maxTexture at one tile's side (shrefract-export --max-texture): more, smaller pages, and every
+// decoded value what the default export's single page holds.
+TEST(GltfExport, SmallerPagesHoldTheSameWeights) {
+    const BakeData d = test::syntheticBake(Precision::F32);
+    GltfExport what;
+    what.bake = &d;
+    const tinygltf::Model one = parse(exportGlb(what));
+    const json r1 = rootExtension(one)["refractions"][0];
+    ASSERT_EQ(r1["weights"].size(), 1u);
+    what.maxTexture = std::max(r1["tileSize"][0].get<int>(), r1["tileSize"][1].get<int>());
+    const tinygltf::Model many = parse(exportGlb(what));
+    const json r = rootExtension(many)["refractions"][0];
+    EXPECT_GT(r["weights"].size(), 1u);
+    for (const auto& t : r["weights"]) {
+        const tinygltf::Image& img = many.images.at(size_t(many.textures.at(t.get<size_t>()).source));
+        EXPECT_LE(std::max(img.width, img.height), what.maxTexture);
+    }
+    const int K = d.coefficientCount(), N = d.layout.sampleCount();
+    int mismatches = 0;
+    for (int k = 0; k < K; ++k)
+        for (int i = 0; i < N; ++i)
+            for (int c = 0; c < 4; ++c) mismatches += decoded(many, r, k, i, c) != decoded(one, r1, k, i, c);
+    EXPECT_EQ(mismatches, 0);
+    // Below one tile it is refused.
+    what.maxTexture -= 1;
+    EXPECT_THROW(exportGlb(what), InputError);
+}
+
 TEST(GltfExport, TheMeshIsTheSampleGrid) {
     const BakeData d = test::syntheticBake(Precision::F32);
     GltfExport what;

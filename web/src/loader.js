@@ -73,11 +73,13 @@ function floatView(buffer, byteOffset, count) {
   return out;
 }
 
-// Bytes a refraction's textures take on the GPU at the formats they are uploaded in (RGBA8 weight
-// pages, the RGBA32F weight range, R32F error layers), and its mesh's vertex and index buffers.
+// Bytes a refraction's textures take on the GPU at the formats they are uploaded in (the RGBA8
+// weight pages as layers of the largest page's size, the RGBA32F weight range, R32F error layers),
+// and its mesh's vertex and index buffers.
 export function gpuBytes(refraction, mesh = null) {
   let textures = refraction.weightRange.image.width * refraction.weightRange.image.height * 16;
-  for (const t of refraction.pages) textures += t.image.width * t.image.height * 4;
+  const pages = refraction.pages.map((t) => t.image);
+  textures += Math.max(...pages.map((i) => i.width)) * Math.max(...pages.map((i) => i.height)) * 4 * pages.length;
   if (refraction.error) {
     const e = refraction.error.texture.image;
     textures += e.width * e.height * e.depth * 4;
@@ -175,7 +177,8 @@ export class SHRefractionLoaderPlugin {
       throw fail(`${what}: scale and offset need ${4 * K} numbers each`);
     const pages = Math.ceil(K / r.tilesPerPage);
     if (r.weights.length < pages) throw fail(`${what}: ${K} coefficients need ${pages} weight pages, it lists ${r.weights.length}`);
-    if (pages > 4) throw fail(`${what}: ${pages} weight pages; this material reads at most 4`);
+    // The material holds the pages as layers of one array texture: WebGL 2 guarantees 256.
+    if (pages > 256) throw fail(`${what}: ${pages} weight pages, above the 256 array layers WebGL 2 guarantees`);
     const maxSize = this.options.maxTextureSize ?? 4096;
     const textures = await Promise.all(r.weights.slice(0, pages).map((t, p) => this.weightPage(t, `${what} weights[${p}]`)));
     for (const [p, tex] of textures.entries()) {

@@ -28,6 +28,40 @@ const _m4 = new THREE.Matrix4();
 const _v3 = new THREE.Vector3();
 const _model = new THREE.Matrix4();
 
+// The atlas pages as the layers of one RGBA8 array texture, so that a bake may have as many pages
+// as WebGL 2 has layers (256 at least; the loader checks). The pages are decoded images (exact:
+// no premultiplication, no colour conversion), which three.js copies into the layers on the GPU
+// (copyTextureToTexture) at the first draw: allocated here, filled by copyPagesOnce.
+function weightPages(pages) {
+  const width = Math.max(...pages.map((t) => t.image.width));
+  const height = Math.max(...pages.map((t) => t.image.height));
+  const array = new THREE.DataArrayTexture(null, width, height, pages.length);
+  array.format = THREE.RGBAFormat;
+  array.type = THREE.UnsignedByteType;
+  array.internalFormat = 'RGBA8';
+  array.minFilter = array.magFilter = THREE.NearestFilter;
+  array.generateMipmaps = false;
+  array.source.dataReady = false;  // storage only: the layers come from the pages
+  array.needsUpdate = true;
+  array.name = 'weight pages';
+  array.userData.copiedFor = null;  // the renderer whose context holds the copied layers
+  return array;
+}
+
+// Fills the array's layers from the pages, once per GL context: a lost and restored context
+// allocates the array afresh (empty), so the copy is made again after 'webglcontextrestored'.
+function copyPagesOnce(renderer, pages, array) {
+  const canvas = renderer.domElement;
+  if (!array.userData.listening && canvas.addEventListener) {
+    array.userData.listening = true;
+    canvas.addEventListener('webglcontextrestored', () => { array.userData.copiedFor = null; });
+  }
+  if (array.userData.copiedFor === renderer) return;
+  const at = new THREE.Vector3();
+  pages.forEach((page, p) => renderer.copyTextureToTexture(page, array, null, at.set(0, 0, p)));
+  array.userData.copiedFor = renderer;
+}
+
 export class SHRefractionMaterial extends THREE.RawShaderMaterial {
   // refraction: what SHRefractionLoaderPlugin read (result.userData.shRefraction.refractions[i]);
   // environment: an environment it read (from this file or an environment-only one).
@@ -38,11 +72,10 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
   } = {}) {
     if (!refraction) throw new Error('SHRefractionMaterial: no refraction');
     const r = refraction;
-    const pages = r.pages.length;
     const useError = !!(errorModel && r.error);
     // Room for the SH through the weights' order and the error model's, whichever is larger.
     const maxOrder = Math.max(r.order, useError ? r.error.order : 0);
-    const defines = { SHREFRACT_SH_MAX_ORDER: maxOrder, SHREFRACT_WEIGHT_PAGES: pages };
+    const defines = { SHREFRACT_SH_MAX_ORDER: maxOrder };
     if (r.basis === 'grid') [defines.SHREFRACT_GRID_THETA, defines.SHREFRACT_GRID_PHI] = r.grid;
     if (useError) defines.SHREFRACT_ERROR_MODEL = '';
     const uniforms = {
@@ -59,6 +92,7 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
       uTilesPerRow: { value: r.tilesPerRow },
       uTilesPerPage: { value: r.tilesPerPage },
       uWeightRange: { value: r.weightRange },
+      uWeightPages: { value: weightPages(r.pages) },
       uErrors: { value: r.error ? r.error.texture : null },
       uErrorOrder: { value: r.error ? r.error.order : 0 },
       uErrorOffset: { value: r.error ? r.error.offset : 0.01 },
@@ -74,7 +108,6 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
       uTaps: { value: 1 },
       ...environmentUniforms(),
     };
-    r.pages.forEach((t, p) => { uniforms[`uWeightPage${p}`] = { value: t }; });
     super({
       glslVersion: THREE.GLSL3,
       vertexShader: withoutVersion(shaderSource('web_shade.vert', defines)),
@@ -101,6 +134,7 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
 
   // Per draw: the uniforms the C++ Refractor::draw and FrameUniforms set.
   onBeforeRender(renderer, scene, camera, geometry, object) {
+    copyPagesOnce(renderer, this.refraction.pages, this.uniforms.uWeightPages.value);
     if (!SHADINGS.includes(this.shading)) throw new Error(`SHRefractionMaterial: shading "${this.shading}": ${SHADINGS.join(' | ')}`);
     const u = this.uniforms, r = this.refraction;
     // The shader works in the bake's space: positions and normals go there by bakeFromLocal, and

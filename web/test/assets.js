@@ -7,6 +7,7 @@ import { execFileSync } from 'node:child_process';
 import { existsSync, mkdirSync, writeFileSync, readFileSync, rmSync } from 'node:fs';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
+import { readGlb } from './glb.js';
 
 const root = resolve(dirname(fileURLToPath(import.meta.url)), '..', '..');
 
@@ -85,6 +86,14 @@ export function makeAssets({ bin, out, full = false, fresh = false, log = () => 
       run(bake, [join(root, input), '-o', exr, ...options, '--precision', 'u8', '-q', '--cache', join(out, 'cache')]);
     }
     if (!existsSync(glb)) run(exporter, [exr, '-o', glb]);
+    // The same bake in pages of one tile each (--max-texture at the tile's side): one page per
+    // coefficient, far past the four that the material once read (pages.test.js).
+    let paged = null;
+    if (!full) {
+      paged = join(out, `${name}_paged.glb`);
+      const [W, H] = readGlb(glb).json.extensions.SHREFRACT_sh_refraction.refractions[0].tileSize;
+      if (!existsSync(paged)) run(exporter, [exr, '-o', paged, '--max-texture', String(Math.max(W, H, 16))]);
+    }
     const views = [];
     for (const [v, [az, el, dist]] of VIEWS.entries()) {
       const png = join(out, `${name}-view${v}.png`), json = join(out, `${name}-view${v}.json`);
@@ -93,7 +102,7 @@ export function makeAssets({ bin, out, full = false, fresh = false, log = () => 
                      '--frames', '1', '--out', png, '--json', json]);
       views.push({ camera: [az, el, dist], png, json });
     }
-    objects[name] = { exr, glb, views };
+    objects[name] = { exr, glb, paged, views };
   }
   const roundTrips = {};
   if (!full) for (const [name, r] of Object.entries(ROUND_TRIPS)) {

@@ -1,6 +1,7 @@
 // WEBGL_lose_context: the context is lost (a frame asked for meanwhile must not throw), then
-// restored, and the material draws the same image again: three re-uploads the weight pages,
-// error layers and cube map from the sources the loader keeps, and recompiles the programs.
+// restored, and the material draws the same image again: three re-uploads the error layers and
+// cube map from the sources the loader keeps and recompiles the programs, and the material copies
+// the weight pages into their array texture again.
 //   node context-loss.test.js --assets DIR
 import { basename } from 'node:path';
 import { openExample, grab, withBrowser } from './browser.js';

@@ -31,8 +31,12 @@ const _model = new THREE.Matrix4();
 // The atlas pages as the layers of one RGBA8 array texture, so that a bake may have as many pages
 // as WebGL 2 has layers (256 at least; the loader checks). The pages are decoded images (exact:
 // no premultiplication, no colour conversion), which three.js copies into the layers on the GPU
-// (copyTextureToTexture) at the first draw: allocated here, filled by copyPagesOnce.
-function weightPages(pages) {
+// (copyTextureToTexture) at the first draw: allocated here, filled by copyPagesOnce. One array per
+// refraction, shared by the materials that draw it (a scene's primitives of one bake).
+const _weightPages = new WeakMap();
+function weightPages(refraction) {
+  if (_weightPages.has(refraction)) return _weightPages.get(refraction);
+  const pages = refraction.pages;
   const width = Math.max(...pages.map((t) => t.image.width));
   const height = Math.max(...pages.map((t) => t.image.height));
   const array = new THREE.DataArrayTexture(null, width, height, pages.length);
@@ -45,6 +49,7 @@ function weightPages(pages) {
   array.needsUpdate = true;
   array.name = 'weight pages';
   array.userData.copiedFor = null;  // the renderer whose context holds the copied layers
+  _weightPages.set(refraction, array);
   return array;
 }
 
@@ -92,7 +97,7 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
       uTilesPerRow: { value: r.tilesPerRow },
       uTilesPerPage: { value: r.tilesPerPage },
       uWeightRange: { value: r.weightRange },
-      uWeightPages: { value: weightPages(r.pages) },
+      uWeightPages: { value: weightPages(r) },
       uErrors: { value: r.error ? r.error.texture : null },
       uErrorOrder: { value: r.error ? r.error.order : 0 },
       uErrorOffset: { value: r.error ? r.error.offset : 0.01 },

@@ -5,6 +5,7 @@
 // Everything the file gets wrong is an Error with a message (loadAsync rejects with it).
 import * as THREE from 'three';
 import { SHRefractionMaterial } from './material.js';
+import { pageLayers } from './pages.js';
 
 export const EXTENSION = 'SHREFRACT_sh_refraction';
 // 2 names each refraction's basis ("sh" or "grid"); 1 is SH only, read as before.
@@ -78,8 +79,8 @@ function floatView(buffer, byteOffset, count) {
 // and its mesh's vertex and index buffers.
 export function gpuBytes(refraction, mesh = null) {
   let textures = refraction.weightRange.image.width * refraction.weightRange.image.height * 16;
-  const pages = refraction.pages.map((t) => t.image);
-  textures += Math.max(...pages.map((i) => i.width)) * Math.max(...pages.map((i) => i.height)) * 4 * pages.length;
+  const { width, height, depth } = pageLayers(refraction.pages);
+  textures += width * height * depth * 4;
   if (refraction.error) {
     const e = refraction.error.texture.image;
     textures += e.width * e.height * e.depth * 4;

@@ -5,6 +5,7 @@
 import * as THREE from 'three';
 import { shaderSource } from './generated/shaders.js';
 import { environmentUniforms, setEnvironmentUniforms, withoutVersion } from './environment.js';
+import { pageLayers } from './pages.js';
 
 const SHADINGS = ['auto', 'jitter', 'spread', 'blend', 'sharp'];
 
@@ -36,10 +37,8 @@ const _model = new THREE.Matrix4();
 const _weightPages = new WeakMap();
 function weightPages(refraction) {
   if (_weightPages.has(refraction)) return _weightPages.get(refraction);
-  const pages = refraction.pages;
-  const width = Math.max(...pages.map((t) => t.image.width));
-  const height = Math.max(...pages.map((t) => t.image.height));
-  const array = new THREE.DataArrayTexture(null, width, height, pages.length);
+  const { width, height, depth } = pageLayers(refraction.pages);
+  const array = new THREE.DataArrayTexture(null, width, height, depth);
   array.format = THREE.RGBAFormat;
   array.type = THREE.UnsignedByteType;
   array.internalFormat = 'RGBA8';
@@ -48,23 +47,25 @@ function weightPages(refraction) {
   array.source.dataReady = false;  // storage only: the layers come from the pages
   array.needsUpdate = true;
   array.name = 'weight pages';
-  array.userData.copiedFor = null;  // the renderer whose context holds the copied layers
   _weightPages.set(refraction, array);
   return array;
 }
 
-// Fills the array's layers from the pages, once per GL context: a lost and restored context
-// allocates the array afresh (empty), so the copy is made again after 'webglcontextrestored'.
+// Fills the array's layers from the pages, once per renderer and GL context. A lost and restored
+// context allocates the array afresh (empty), so a renderer's 'webglcontextrestored' forgets what
+// it had copied and the next draw copies again.
+const _copied = new WeakMap();  // renderer -> the arrays whose layers its context holds
 function copyPagesOnce(renderer, pages, array) {
-  const canvas = renderer.domElement;
-  if (!array.userData.listening && canvas.addEventListener) {
-    array.userData.listening = true;
-    canvas.addEventListener('webglcontextrestored', () => { array.userData.copiedFor = null; });
+  let copied = _copied.get(renderer);
+  if (!copied) {
+    copied = new WeakSet();
+    _copied.set(renderer, copied);
+    renderer.domElement.addEventListener?.('webglcontextrestored', () => _copied.delete(renderer));
   }
-  if (array.userData.copiedFor === renderer) return;
+  if (copied.has(array)) return;
   const at = new THREE.Vector3();
   pages.forEach((page, p) => renderer.copyTextureToTexture(page, array, null, at.set(0, 0, p)));
-  array.userData.copiedFor = renderer;
+  copied.add(array);
 }
 
 export class SHRefractionMaterial extends THREE.RawShaderMaterial {

@@ -3,6 +3,7 @@
 import { existsSync } from 'node:fs';
 import { chromium } from 'playwright-core';
 import { startServer } from '../example/serve.js';
+import { objectPsnr } from './images.js';
 
 export const CHROMIUM = process.env.SHREFRACT_CHROMIUM || '/usr/bin/chromium';
 
@@ -74,6 +75,23 @@ export async function grab(page) {
   const mask = await page.evaluate(() => shrefract.coverage());
   const decode = (b64) => ({ width: w, height: h, data: new Uint8Array(Buffer.from(b64, 'base64')) });
   return { color: decode(color), mask: decode(mask) };
+}
+
+// The example drawn with `params`, then again with `variant` ({ params, options }: other query
+// parameters, or openExample's options such as an init script): the second frame's object PSNR
+// against the first, over the first frame's glass. probe(page), when given, runs on each page
+// before it closes (guard it: it runs on a page that shows an error too).
+export async function sameFrameAs(browser, base, params, variant, probe = async () => null) {
+  const first = await openExample(browser, base, params);
+  const reference = await grab(first);
+  const probedFirst = await probe(first);
+  await first.context().close();
+  const page = await openExample(browser, base, variant.params ?? params, variant.options ?? {});
+  const ready = page.state.state === 'ready';
+  const probed = await probe(page);
+  const r = ready ? objectPsnr((await grab(page)).color, reference.color, reference.mask) : { psnr: 0, pixels: 0 };
+  await page.context().close();
+  return { ready, ...r, probedFirst, probed, error: page.state.error, problems: page.problems };
 }
 
 // Serves web/ with the test's asset folder under /files/.

@@ -4,8 +4,7 @@
 // texels, so the frame must be drawn and equal the unrestricted one.
 //   node phone-limits.test.js --assets DIR
 import { basename } from 'node:path';
-import { openExample, grab, withBrowser } from './browser.js';
-import { objectPsnr } from './images.js';
+import { sameFrameAs, withBrowser } from './browser.js';
 import { readAssets } from './assets.js';
 
 const arg = (k, d) => { const i = process.argv.indexOf(k); return i > 0 ? process.argv[i + 1] : d; };
@@ -34,24 +33,19 @@ await withBrowser(dir, {}, async (browser, base) => {
   let failed = false;
   for (const [name, object] of Object.entries(assets.objects)) {
     const params = { glb: `/files/${basename(object.glb)}`, env: `/files/${basename(assets.env)}`, size: '128x128' };
-    const plain = await openExample(browser, base, params);
-    const reference = await grab(plain);
-    await plain.context().close();
-    const page = await openExample(browser, base, params, { initScript: phone });
-    const seen = await page.evaluate(() => ({
+    const limits = (page) => page.evaluate(() => shrefract.renderer && ({
       maxTextureSize: shrefract.renderer.capabilities.maxTextureSize,
       colorBufferFloat: shrefract.renderer.extensions.has('EXT_color_buffer_float'),
     }));
-    const ready = page.state.state === 'ready';
-    const r = ready ? objectPsnr((await grab(page)).color, reference.color, reference.mask) : { psnr: 0, pixels: 0 };
+    const r = await sameFrameAs(browser, base, params, { options: { initScript: phone } }, limits);
+    const seen = r.probed || {};
     // Measured: identical pixels; 60 dB still fails a blank or broken frame (below 15 dB).
-    const ok = ready && seen.maxTextureSize === 4096 && !seen.colorBufferFloat && r.psnr >= 60 && r.pixels > 100 &&
-               !page.problems.length;
+    const ok = r.ready && seen.maxTextureSize === 4096 && !seen.colorBufferFloat && r.psnr >= 60 && r.pixels > 100 &&
+               !r.problems.length;
     failed ||= !ok;
     console.log(`${ok ? 'ok  ' : 'FAIL'} ${name}: MAX_TEXTURE_SIZE ${seen.maxTextureSize}, EXT_color_buffer_float ` +
-                `${seen.colorBufferFloat ? 'present' : 'hidden'}; ${ready ? `vs unrestricted: PSNR ${r.psnr} dB over ${r.pixels} px` : `page error: ${page.state.error}`}` +
-                `${page.problems.length ? `; page: ${page.problems.join('; ')}` : ''}`);
-    await page.context().close();
+                `${seen.colorBufferFloat ? 'present' : 'hidden'}; ${r.ready ? `vs unrestricted: PSNR ${r.psnr} dB over ${r.pixels} px` : `page error: ${r.error}`}` +
+                `${r.problems.length ? `; page: ${r.problems.join('; ')}` : ''}`);
   }
   return failed;
 });

@@ -279,12 +279,22 @@ AtlasLayout atlasLayout(int K, int N, int W, int maxSide) {
         throw InputError("one coefficient's " + std::to_string(a.tile[0]) + " x " +
                          std::to_string(a.tile[1]) + " texels exceed the " +
                          std::to_string(maxSide) + " texel limit of a glTF texture here");
-    // Near-square pages: as many tile columns as rows, within the page limit.
-    const int columns = static_cast<int>(std::ceil(std::sqrt(double(K) * a.tile[1] / a.tile[0])));
-    a.tilesPerRow = std::clamp(columns, 1, maxSide / a.tile[0]);
-    const int rows = std::clamp((K + a.tilesPerRow - 1) / a.tilesPerRow, 1, maxSide / a.tile[1]);
-    a.tilesPerPage = a.tilesPerRow * rows;
-    a.pages = (K + a.tilesPerPage - 1) / a.tilesPerPage;
+    // n tiles on a near-square page (as wide as tall), within the page limit.
+    const int maxColumns = maxSide / a.tile[0], maxRows = maxSide / a.tile[1];
+    const auto arrange = [&](int n) {
+        a.tilesPerRow = std::clamp(static_cast<int>(std::ceil(std::sqrt(double(n) * a.tile[1] / a.tile[0]))), 1,
+                                   maxColumns);
+        const int rows = std::clamp((n + a.tilesPerRow - 1) / a.tilesPerRow, 1, maxRows);
+        a.tilesPerRow = std::min(maxColumns, (n + rows - 1) / rows);  // rows at the limit: widen
+        a.tilesPerPage = a.tilesPerRow * rows;
+        a.pages = (K + a.tilesPerPage - 1) / a.tilesPerPage;
+    };
+    // As few pages as the limit allows, then the coefficients shared out evenly among them: a
+    // last page holding a few tiles would cost a whole layer in the web material's array texture,
+    // whose layers all have the largest page's size (512 grid tiles at 4096: 441 + 71 tiles made
+    // two 4095 x 4074 layers, 256 + 256 make two of 3120 x 3104).
+    arrange(K);
+    if (a.pages > 1) arrange((K + a.pages - 1) / a.pages);
     return a;
 }
 

@@ -27,7 +27,8 @@ struct AtlasLayout {
     int pageHeight(int p) const;
 };
 // The atlas for K coefficients of N samples, W samples per tile row, pages at most maxSide
-// square; throws std::invalid_argument when one tile does not fit.
+// square: the fewest pages that hold them, the tiles shared evenly among them, each page near
+// square. Throws InputError when one tile does not fit.
 AtlasLayout atlasLayout(int K, int N, int W, int maxSide = kMaxGltfTexture);
 
 // The 8-bit codes of every coefficient, laid out as RGBA8 pages of the atlas, and the scale and

@@ -46,16 +46,16 @@ out vec3 vObjectPosition;  // where on the object: a seed that moves with it (ji
 out vec3 vNormal;
 out vec4 vD;
 
-vec4 weightTexel(int k, int i) {
-    int page = k / uTilesPerPage, j = k - page * uTilesPerPage;
-    ivec2 t = ivec2((j % uTilesPerRow) * uTileSize.x + i % uTileSize.x,
-                    (j / uTilesPerRow) * uTileSize.y + i / uTileSize.x);
-    return texelFetch(uWeightPages, ivec3(t, page), 0);
+// Coefficient k's code at texel s of its tile (s: the sample's texel within a tile), decoded.
+vec4 weightAt(int k, ivec3 tile, ivec2 s) {
+    vec4 code = texelFetch(uWeightPages, ivec3(tile.xy + s, tile.z), 0);
+    return code * texelFetch(uWeightRange, ivec2(k, 0), 0) + texelFetch(uWeightRange, ivec2(k, 1), 0);
 }
 
-// Coefficient k of sample i, decoded.
-vec4 weight(int k, int i) {
-    return weightTexel(k, i) * texelFetch(uWeightRange, ivec2(k, 0), 0) + texelFetch(uWeightRange, ivec2(k, 1), 0);
+// Where coefficient k's tile starts: texel (x, y) of page z.
+ivec3 tileOf(int k) {
+    int page = k / uTilesPerPage, j = k - page * uTilesPerPage;
+    return ivec3((j % uTilesPerRow) * uTileSize.x, (j / uTilesPerRow) * uTileSize.y, page);
 }
 
 void main() {
@@ -71,26 +71,39 @@ void main() {
 #else
     shEvalEven(uOrder, w, y);
 #endif
+    ivec2 s = ivec2(i % uTileSize.x, i / uTileSize.x);  // the sample's texel in every tile
     vec4 d = vec4(0.0);
 #ifdef SHREFRACT_GRID_THETA
     ivec4 corner;
     vec4 cornerWeight;
     gridCorners(w, corner, cornerWeight);
-    for (int c = 0; c < 4; ++c) d += cornerWeight[c] * weight(corner[c], i);
+    for (int c = 0; c < 4; ++c) d += cornerWeight[c] * weightAt(corner[c], tileOf(corner[c]), s);
 #else
+    // The tiles in order, stepped along the rows and pages rather than divided out per
+    // coefficient (integer division is dear where the vertex stage runs on a CPU).
     int count = (uOrder + 1) * (uOrder + 2) / 2;
+    ivec3 tile = ivec3(0);
+    int column = 0, onPage = 0;
     for (int k = 0; k < SHREFRACT_SH_MAX_COUNT; ++k) {
         if (k >= count) break;
-        d += weight(k, i) * y[k];
+        d += weightAt(k, tile, s) * y[k];
+        if (++onPage == uTilesPerPage) {
+            tile = ivec3(0, 0, tile.z + 1);
+            column = onPage = 0;
+        } else if (++column == uTilesPerRow) {
+            tile.xy = ivec2(0, tile.y + uTileSize.y);
+            column = 0;
+        } else {
+            tile.x += uTileSize.x;
+        }
     }
 #endif
 #ifdef SHREFRACT_ERROR_MODEL
     int errorCount = (uErrorOrder + 1) * (uErrorOrder + 2) / 2;
     float e = 0.0;
-    ivec2 t = ivec2(i % uTileSize.x, i / uTileSize.x);
     for (int k = 0; k < SHREFRACT_SH_MAX_COUNT; ++k) {
         if (k >= errorCount) break;
-        e += texelFetch(uErrors, ivec3(t, k), 0).r * y[k];
+        e += texelFetch(uErrors, ivec3(s, k), 0).r * y[k];
     }
     float err = max(exp(e) - uErrorOffset, 0.0);
     float len = length(d.xyz);

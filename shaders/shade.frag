@@ -30,6 +30,8 @@ uniform float uBlendSigma;      // > 0 (blend shading): the sharp lookup and the
 uniform float uJitterCell;      // > 0 (jitter shading): one direction drawn within the lobe per
                                 // cell of this size (object units), instead of the lobe's mean;
                                 // oDirection keeps the bake's exit (what the metrics measure)
+uniform float uJitterGate;      // jitter: the lobe width (radians) where the lookup turns from a
+                                // sure fragment's to an unsure one's (0: ungated)
 uniform float uFootprintScale;  // factor on the screen-space turn of a direction per pixel
 uniform int uTaps;              // 1: one lookup at the pixel's centre; 4: four inside it, averaged
 in vec3 vPosition;
@@ -56,7 +58,8 @@ vec3 shadeOne(vec4 r, vec3 objectPosition, vec3 n, vec3 v) {
     float reflectSigma = 0.0, spread = 0.0;
     if (uSpread) {
         spread = spreadSigma(resultant, uSpreadScale);
-        lookup = transmissionLookup(exitWorld, spread, uFootprintScale, uJitterCell, objectPosition);
+        lookup = transmissionLookup(exitWorld, spread, uFootprintScale, uJitterCell, uJitterGate,
+                                    objectPosition);
         reflectSigma = footprintSigma(reflect(-v, n), uFootprintScale);
     }
     vec3 c = shadeGlass(lookup.xyz, lookup.w, r.w, n, v, uEta, uKappa, reflectSigma);

@@ -30,6 +30,7 @@ uniform bool uSpread;
 uniform float uSpreadScale;
 uniform float uFootprintScale;
 uniform float uJitterCell;  // as shade.frag's (blend shading is shaded as spread here)
+uniform float uJitterGate;
 in vec3 vPosition;
 in vec3 vObjectPosition;
 in vec3 vNormal;
@@ -78,7 +79,7 @@ void main() {
         vec4 lookup = vec4(e, 0.0);
         if (uSpread)
             lookup = transmissionLookup(e, spreadSigma(mix(resA, resB, uBlend[k]), uSpreadScale),
-                                        uFootprintScale, uJitterCell, vObjectPosition);
+                                        uFootprintScale, uJitterCell, uJitterGate, vObjectPosition);
         c[k] = shadeGlass(lookup.xyz, lookup.w, mix(lenA, lenB, uBlend[k]), n, v, uEtaRGB[k], uKappa,
                           reflectSigma)[k];
         if (k == 1) exitG = e;

@@ -62,11 +62,22 @@ vec3 lobeDirection(vec3 d, float sigma, vec3 cell) {
 // 0): one direction drawn from the lobe, seeded by the object-space cell of objectPosition, looked
 // up over the pixel's footprint; otherwise the lobe's mean, the lobe widened by the footprint in
 // quadrature. .xyz the direction, .w the width of its lookup.
+//
+// Jitter is gated by the lobe's width (jitterGate > 0, docs/runtime.md "The gate"): where the bake
+// is sure (g = spread / jitterGate near 0) the draw is the lobe and the lookup the drawn
+// direction's footprint; where it is unsure (g = 1) the draw is kWideDraw wider and the lookup at
+// least kExitFootprint of a pixel's turn of the exit, which antialiases a chaotic mapping as the
+// reference's pixel does. jitterGate 0: the ungated jitter.
+const float kWideDraw = 0.667;      // spread scale 0.15 -> 0.25 where g = 1
+const float kExitFootprint = 0.4;   // a pixel box's standard deviation is 0.29 of its width
 vec4 transmissionLookup(vec3 e, float spread, float footprintScale, float jitterCell,
-                        vec3 objectPosition) {
+                        float jitterGate, vec3 objectPosition) {
     if (jitterCell > 0.0) {
-        vec3 d = lobeDirection(e, spread, floor(objectPosition / jitterCell));
-        return vec4(d, footprintSigma(d, footprintScale));
+        float g = jitterGate > 0.0 ? min(1.0, spread / jitterGate) : 0.0;
+        vec3 d = lobeDirection(e, spread * (1.0 + kWideDraw * g),
+                               floor(objectPosition / jitterCell));
+        return vec4(d, max(footprintSigma(d, footprintScale),
+                           footprintSigma(e, kExitFootprint * g)));
     }
     float footprint = footprintSigma(e, footprintScale);
     return vec4(e, sqrt(spread * spread + footprint * footprint));

@@ -78,6 +78,8 @@ int main(int argc, char** argv) {
                        "on SH bakes, blend on grid-basis ones)");
     app.add_option("--jitter-cell", sh.jitterCell, "sh, jitter shading: the cell of one drawn direction, a fraction of the object's bounding-box diagonal")
         ->capture_default_str()->check(CLI::Range(1e-6f, 10.0f));
+    app.add_option("--jitter-gate", sh.jitterGate, "sh, jitter shading: the lobe width (radians) from which the draw widens and the lookup covers the exit's pixel (0: ungated)")
+        ->capture_default_str()->check(CLI::Range(0.0f, 10.0f));
     app.add_option("--taps", sh.taps, "sh: lookups per pixel, averaged: 1 (its centre) | 4 (at +-1/4 pixel) | -1 (4 on grid-basis bakes, 1 on SH)")
         ->capture_default_str()->check(CLI::IsMember({-1, 1, 4}));
     app.add_option("--blend-sigma", sh.blendSigma, "sh, blend shading: lobe width (radians) at which the lobe has half the weight")

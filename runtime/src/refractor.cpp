@@ -101,6 +101,10 @@ std::unique_ptr<Refractor> Refractor::create(const Bake& bake, const RefractorOp
     // Four taps on a grid-basis bake: its sharper exits alias where SH's low-pass does not
     // (docs/runtime.md "Four taps": scripts/compare's chart).
     if (options.taps == -1) m->options.taps = d.basis == Basis::Grid ? 4 : 1;
+    if (!(options.jitterGate >= 0.0f))
+        throw std::invalid_argument("shrefract: RefractorOptions jitterGate " +
+                                    std::to_string(options.jitterGate) +
+                                    ": 0 (ungated) or more radians");
     GLint units = 16;
     glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &units);
     const PipelineInputs in{bake,        m->options,         m->settings, m->maxOrder,
@@ -185,6 +189,7 @@ void Refractor::draw(const Environment& environment) {
     glUniform1f(glGetUniformLocation(p, "uBlendSigma"), o.shading == Shading::Blend ? o.blendSigma : 0.0f);
     glUniform1f(glGetUniformLocation(p, "uJitterCell"),
                 o.shading == Shading::Jitter ? o.jitterCell * m.diagonal : 0.0f);
+    glUniform1f(glGetUniformLocation(p, "uJitterGate"), o.jitterGate);
     glUniform1f(glGetUniformLocation(p, "uFootprintScale"), o.footprintScale);
     glUniform1i(glGetUniformLocation(p, "uTaps"), o.taps);
     useEnvironment(p, environment, 0);

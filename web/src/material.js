@@ -73,8 +73,8 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
   // environment: an environment it read (from this file or an environment-only one).
   constructor({
     refraction, environment = null, shading = 'auto', order = -1, spreadScale = 0.15,
-    footprintScale = 0.15, taps = -1, jitterCell = 0.005, blendSigma = 0.1, errorModel = true,
-    toneMap = true, exposure = 1.0, absorption = null, bakeFromLocal = null,
+    footprintScale = 0.15, taps = -1, jitterCell = 0.005, jitterGate = 0.05, blendSigma = 0.1,
+    errorModel = true, toneMap = true, exposure = 1.0, absorption = null, bakeFromLocal = null,
   } = {}) {
     if (!refraction) throw new Error('SHRefractionMaterial: no refraction');
     const r = refraction;
@@ -110,6 +110,7 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
       uSpreadScale: { value: spreadScale },
       uBlendSigma: { value: 0 },
       uJitterCell: { value: 0 },
+      uJitterGate: { value: jitterGate },
       uFootprintScale: { value: footprintScale },
       uTaps: { value: 1 },
       ...environmentUniforms(),
@@ -129,6 +130,7 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
     this.footprintScale = footprintScale;
     this.taps = taps;
     this.jitterCell = jitterCell;
+    this.jitterGate = jitterGate;  // radians; 0: ungated (docs/runtime.md "The gate")
     this.blendSigma = blendSigma;
     this.toneMap = toneMap;
     this.exposure = exposure;
@@ -142,6 +144,9 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
   onBeforeRender(renderer, scene, camera, geometry, object) {
     copyPagesOnce(renderer, this.refraction.pages, this.uniforms.uWeightPages.value);
     if (!SHADINGS.includes(this.shading)) throw new Error(`SHRefractionMaterial: shading "${this.shading}": ${SHADINGS.join(' | ')}`);
+    if (!(this.jitterGate >= 0)) {
+      throw new Error(`SHRefractionMaterial: jitterGate ${this.jitterGate}: 0 (ungated) or more radians`);
+    }
     const u = this.uniforms, r = this.refraction;
     // The shader works in the bake's space: positions and normals go there by bakeFromLocal, and
     // from there to the world by matrixWorld * bakeFromLocal^-1.
@@ -165,6 +170,7 @@ export class SHRefractionMaterial extends THREE.RawShaderMaterial {
     u.uSpread.value = shading !== 'sharp';
     u.uBlendSigma.value = shading === 'blend' ? this.blendSigma : 0;
     u.uJitterCell.value = shading === 'jitter' ? this.jitterCell * r.boundsDiagonal : 0;
+    u.uJitterGate.value = this.jitterGate;
     u.uFootprintScale.value = this.footprintScale;
     u.uTaps.value = resolveTaps(this.taps, r);
     setEnvironmentUniforms(u, this.environment);

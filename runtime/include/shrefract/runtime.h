@@ -214,6 +214,11 @@ struct RefractorOptions {
     // object's bounding-box diagonal; about two pixels where the object spans 400), the same in
     // every frame, instead of the lobe's mean (docs/runtime.md "Jitter shading").
     float jitterCell = 0.005f;
+    // Jitter, gated by the lobe's width: at lobes this wide (radians) and wider, the draw widens
+    // by two thirds and the lookup takes at least 0.4 of a pixel's turn of the exit; narrower, it
+    // goes linearly to the plain draw (docs/runtime.md "The gate"). 0: ungated. Negative:
+    // std::invalid_argument.
+    float jitterGate = 0.05f;
     // Lookups per pixel, averaged: 1 at its centre, or 4 at (+-1/4, +-1/4) pixel, which
     // antialiases the exit's pattern inside the pixel (docs/runtime.md "Four taps"). -1: the
     // measured default for the bake's basis, 4 on a grid-basis bake and 1 on SH; taps() tells.

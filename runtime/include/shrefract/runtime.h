@@ -215,8 +215,8 @@ struct RefractorOptions {
     // every frame, instead of the lobe's mean (docs/runtime.md "Jitter shading").
     float jitterCell = 0.005f;
     // Jitter, gated by the lobe's width: at lobes this wide (radians) and wider, the draw widens
-    // by two thirds and the lookup takes at least 0.4 of a pixel's turn of the exit; narrower, it
-    // goes linearly to the plain draw (docs/runtime.md "The gate"). 0: ungated. Negative:
+    // by two thirds and the lookup takes at least 0.4 of a pixel's turn of the exit; below 0.6 of
+    // it, the plain draw; linear between (docs/runtime.md "The gate"). 0: ungated. Negative:
     // std::invalid_argument.
     float jitterGate = 0.05f;
     // Lookups per pixel, averaged: 1 at its centre, or 4 at (+-1/4, +-1/4) pixel, which

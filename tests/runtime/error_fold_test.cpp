@@ -14,6 +14,7 @@
 #include "common/limits.h"
 #include "common/prefilter.h"
 #include "common/sh.h"
+#include "support/frame_mask.h"
 #include "support/headless.h"
 #include "shrefract/render.h"
 #include "shrefract/runtime.h"
@@ -180,19 +181,8 @@ TEST_P(ErrorFoldTest, JitterDrawsFromThePredictedLobe) {
         double sum2 = 0, worstExit = 0;
         glm::dvec3 mean(0.0);
         size_t covered = 0;
-        // Pixels two or more from the silhouette: at grazing incidence Fresnel reflects
-        // everything, even at index 1 (as Paths.SpreadLookupMatchesItsCpuTwin).
-        auto inside = [&](int x, int y) {
-            for (int dy = -2; dy <= 2; ++dy)
-                for (int dx = -2; dx <= 2; ++dx) {
-                    const int xx = x + dx, yy = y + dy;
-                    if (xx < 0 || yy < 0 || xx >= 64 || yy >= 64) return false;
-                    if (a.directions[(size_t(yy) * 64 + xx) * 4 + 3] < 0.5f) return false;
-                }
-            return true;
-        };
         for (size_t i = 0; i < a.directions.size(); i += 4) {
-            if (!inside(int(i / 4 % 64), int(i / 4 / 64))) continue;
+            if (!test::coveredAround(a, int(i / 4 % 64), int(i / 4 / 64))) continue;  // 2 px from the edge
             const glm::vec3 exit(a.directions[i], a.directions[i + 1], a.directions[i + 2]);
             worstExit = std::max(worstExit, double(glm::length(exit - e)));
             const glm::vec3 d = glm::normalize(2.0f * glm::vec3(a.color[i], a.color[i + 1], a.color[i + 2]) - 1.0f);

@@ -14,6 +14,7 @@
 #include "common/latlong.h"
 #include "common/prefilter.h"
 #include "common/sh.h"
+#include "support/frame_mask.h"
 #include "support/headless.h"
 #include "shrefract/context.h"
 #include "shrefract/render.h"
@@ -303,19 +304,8 @@ TEST_P(Paths, SpreadLookupMatchesItsCpuTwin) {
         const glm::vec3 expect = sampleCubeLod(cube, e, lodForSigma(sigma, env.faceSize(), env.levels()));
         double worst = 0;
         size_t covered = 0;
-        // Pixels two or more from the silhouette: there the interpolated normal faces the viewer
-        // and IOR 1 reflects nothing (at grazing incidence Fresnel reflects everything).
-        auto inside = [&](int x, int y) {
-            for (int dy = -2; dy <= 2; ++dy)
-                for (int dx = -2; dx <= 2; ++dx) {
-                    const int xx = x + dx, yy = y + dy;
-                    if (xx < 0 || yy < 0 || xx >= 48 || yy >= 48) return false;
-                    if (f.directions[(size_t(yy) * 48 + xx) * 4 + 3] < 0.5f) return false;
-                }
-            return true;
-        };
         for (size_t i = 0; i < f.color.size(); i += 4) {
-            if (!inside(int(i / 4 % 48), int(i / 4 / 48))) continue;
+            if (!test::coveredAround(f, int(i / 4 % 48), int(i / 4 / 48))) continue;  // 2 px from the edge
             ++covered;
             for (int c = 0; c < 3; ++c) worst = std::max(worst, double(std::abs(f.color[i + c] - expect[c]) / expect[c]));
         }

@@ -64,21 +64,22 @@ vec3 lobeDirection(vec3 d, float sigma, vec3 cell) {
 // quadrature. .xyz the direction, .w the width of its lookup.
 //
 // Jitter is gated by the lobe's width (jitterGate > 0, docs/runtime.md "The gate"): where the bake
-// is sure (spread below kGateOpens x jitterGate, g = 0) the draw is the lobe and the lookup the
-// drawn direction's footprint; where it is unsure (spread >= jitterGate, g = 1) the draw is
-// kWideDraw wider and the lookup at least kExitFootprint of a pixel's turn of the exit, which
-// antialiases a chaotic mapping as the reference's pixel does; g rises linearly between.
-// jitterGate 0: the ungated jitter.
+// is sure (spread below kGateOpens x jitterGate, g = 0) the draw is kSureDraw of the lobe and the
+// lookup the drawn direction's footprint; where it is unsure (spread >= jitterGate, g = 1) the draw
+// is kUnsureDraw of the lobe and the lookup at least kExitFootprint of a pixel's turn of the exit,
+// which antialiases a chaotic mapping as the reference's pixel does; g rises linearly between.
+// jitterGate 0: the ungated jitter (the draw is the lobe).
 const float kGateOpens = 0.6;
-const float kWideDraw = 0.667;      // spread scale 0.15 -> 0.25 where g = 1
+const float kSureDraw = 0.333;      // at spread scale 0.15: 0.05 of the predicted error where g = 0
+const float kUnsureDraw = 2.0;      // and 0.3 of it where g = 1
 const float kExitFootprint = 0.4;   // a pixel box's standard deviation is 0.29 of its width
 vec4 transmissionLookup(vec3 e, float spread, float footprintScale, float jitterCell,
                         float jitterGate, vec3 objectPosition) {
     if (jitterCell > 0.0) {
         float g = jitterGate > 0.0
             ? clamp((spread / jitterGate - kGateOpens) / (1.0 - kGateOpens), 0.0, 1.0) : 0.0;
-        vec3 d = lobeDirection(e, spread * (1.0 + kWideDraw * g),
-                               floor(objectPosition / jitterCell));
+        float draw = jitterGate > 0.0 ? mix(kSureDraw, kUnsureDraw, g) : 1.0;
+        vec3 d = lobeDirection(e, spread * draw, floor(objectPosition / jitterCell));
         return vec4(d, max(footprintSigma(d, footprintScale),
                            footprintSigma(e, kExitFootprint * g)));
     }

@@ -144,13 +144,16 @@ Environment checkerEnvironment() {
     return Environment::fromLatLong(w, h, rgb, 64);
 }
 
-// Jitter shading draws one direction per object cell from the lobe the model predicts: over many
-// pixels the angles to the baked exit have the RMS of a 2D Gaussian of that width, sqrt(2) sigma,
-// the draws centre on the exit, the same frame drawn again is the same (no flicker), and the
-// direction buffer keeps the bake's exit (what the metrics measure). The gate widens the lobe by
-// 1 + 0.667 g, g = clamp((sigma / gate - 0.6) / 0.4, 0, 1) (shading.glsl kWideDraw, kGateOpens):
-// not at all ungated, by two thirds at the default gate, which this lobe exceeds, by a third at
-// sigma = 0.8 gate, and not at all at sigma = 0.5 gate, below where the gate opens.
+// Jitter shading draws one direction per object cell from the lobe the model predicts: a 2D
+// Gaussian offset r of that width in the exit's tangent plane, so the angle to the exit, atan |r|,
+// has the median atan(sigma sqrt(2 ln 2)) (|r| is Rayleigh-distributed, atan is monotone). The
+// median, not the RMS: where the interpolated normal grazes the view, Fresnel reflects even at
+// index 1, and two such pixels would add 0.07 rad to an RMS. The draws centre on the exit, the
+// same frame drawn again is the same (no flicker), and the direction buffer keeps the bake's exit
+// (what the metrics measure). The gate scales the lobe by 0.333 + 1.667 g, g = clamp((sigma /
+// gate - 0.6) / 0.4, 0, 1) (shading.glsl kSureDraw, kUnsureDraw, kGateOpens): ungated by 1, at
+// the default gate, which this lobe exceeds, by 2, at sigma = 0.8 gate by 1.17, and at sigma =
+// 0.5 gate, below where the gate opens, by a third.
 TEST_P(ErrorFoldTest, JitterDrawsFromThePredictedLobe) {
     BakeData data = test::randomBake(2, 1);
     data.manifest["media"][0]["ior"] = 1.0;  // no front reflection
@@ -178,32 +181,34 @@ TEST_P(ErrorFoldTest, JitterDrawsFromThePredictedLobe) {
         const RenderedFrame a = renderFrame(*r, env, Camera::orbit(30, 20, 3.5f), 64, 64);
         const RenderedFrame b = renderFrame(*r, env, Camera::orbit(30, 20, 3.5f), 64, 64);
         EXPECT_EQ(a.color, b.color) << "the same frame drew other directions";
-        double sum2 = 0, worstExit = 0;
+        double worstExit = 0;
+        std::vector<double> angles;
         glm::dvec3 mean(0.0);
-        size_t covered = 0;
         for (size_t i = 0; i < a.directions.size(); i += 4) {
             if (!test::coveredAround(a, int(i / 4 % 64), int(i / 4 / 64))) continue;  // 2 px from the edge
             const glm::vec3 exit(a.directions[i], a.directions[i + 1], a.directions[i + 2]);
             worstExit = std::max(worstExit, double(glm::length(exit - e)));
             const glm::vec3 d = glm::normalize(2.0f * glm::vec3(a.color[i], a.color[i + 1], a.color[i + 2]) - 1.0f);
-            const double angle = std::acos(std::clamp(double(glm::dot(d, e)), -1.0, 1.0));
-            sum2 += angle * angle, mean += glm::dvec3(d), ++covered;
+            angles.push_back(std::acos(std::clamp(double(glm::dot(d, e)), -1.0, 1.0)));
+            mean += glm::dvec3(d);
         }
-        ASSERT_GT(covered, 400u);
+        ASSERT_GT(angles.size(), 400u);
         EXPECT_LT(worstExit, 1e-4) << "the direction buffer should hold the bake's exit, not the draw";
         const double g = gate > 0.0f ? std::clamp((double(sigma) / gate - 0.6) / 0.4, 0.0, 1.0) : 0.0;
-        const double rms = std::sqrt(sum2 / covered);
-        const double expected = std::sqrt(2.0) * sigma * (1.0 + 0.667 * g);
+        const double draw = gate > 0.0f ? 0.333 + 1.667 * g : 1.0;
+        std::nth_element(angles.begin(), angles.begin() + angles.size() / 2, angles.end());
+        const double median = angles[angles.size() / 2];
+        const double expected = std::atan(sigma * draw * std::sqrt(2.0 * std::log(2.0)));
         const double centre = std::acos(std::clamp(glm::dot(glm::normalize(mean), glm::dvec3(e)), -1.0, 1.0));
-        std::printf("[%s] gate %.3f: %zu px: RMS angle %.4f rad (expected %.4f), mean off the "
-                    "exit by %.4f rad\n", nameOf(GetParam()), gate, covered, rms, expected, centre);
-        // Measured on llvmpipe, 594 pixels: RMS 0.2897 rad against 0.2803 ungated (3 % over: a
-        // finite sample of hashed draws, and the cube map's bilinear lookup), 0.4405 against
-        // 0.4673 at the default gate (6 % under), 0.3686 against 0.3738 at 1.25 times the lobe,
-        // and the ungated figure at twice it (below where the gate opens); centred within 0.01 rad. A lobe of the wrong width (the error not read, a missing
-        // sqrt(-2 ln u), the gate ignored or always saturated) is off by 20 % or more.
-        EXPECT_NEAR(rms, expected, 0.1 * expected) << "gate " << gate;
-        EXPECT_LT(centre, 0.03 * (1.0 + 0.667 * g));
+        std::printf("[%s] gate %.3f: %zu px: median angle %.4f rad (expected %.4f), mean off the "
+                    "exit by %.4f rad\n", nameOf(GetParam()), gate, angles.size(), median, expected, centre);
+        // Measured on llvmpipe (both backends), 594 pixels: 3.9-4.5 % over at all four gates (a
+        // finite sample of hashed draws: 0.2392 against 0.2293 ungated, 0.4537 against 0.4367 at
+        // the default gate, 0.2774 / 0.2658, 0.0811 / 0.0776); centred within 0.011 rad. Planted:
+        // the unsure draw at 1.667 (stop 43's) is 12 % under at the default gate, the sure draw
+        // at 1 is 32 % over at 0.8 of it, and the ungated draw at a third 65 % under.
+        EXPECT_NEAR(median, expected, 0.1 * expected) << "gate " << gate;
+        EXPECT_LT(centre, 0.03 * draw);
     }
     RefractorOptions negative;
     negative.loader = context_->loader();

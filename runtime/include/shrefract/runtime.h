@@ -214,10 +214,10 @@ struct RefractorOptions {
     // object's bounding-box diagonal; about two pixels where the object spans 400), the same in
     // every frame, instead of the lobe's mean (docs/runtime.md "Jitter shading").
     float jitterCell = 0.005f;
-    // Jitter, gated by the lobe's width: at lobes this wide (radians) and wider, the draw widens
-    // by two thirds and the lookup takes at least 0.4 of a pixel's turn of the exit; below 0.6 of
-    // it, the plain draw; linear between (docs/runtime.md "The gate"). 0: ungated. Negative:
-    // std::invalid_argument.
+    // Jitter, gated by the lobe's width: at lobes this wide (radians) and wider, the draw is twice
+    // the lobe and the lookup takes at least 0.4 of a pixel's turn of the exit; below 0.6 of it,
+    // the draw is a third of the lobe; linear between (docs/runtime.md "The gate"). 0: ungated
+    // (the draw is the lobe). Negative: std::invalid_argument.
     float jitterGate = 0.05f;
     // Lookups per pixel, averaged: 1 at its centre, or 4 at (+-1/4, +-1/4) pixel, which
     // antialiases the exit's pattern inside the pixel (docs/runtime.md "Four taps"). -1: the

@@ -76,9 +76,11 @@ const float kExitFootprint = 0.4;   // a pixel box's standard deviation is 0.29 
 vec4 transmissionLookup(vec3 e, float spread, float footprintScale, float jitterCell,
                         float jitterGate, vec3 objectPosition) {
     if (jitterCell > 0.0) {
-        float g = jitterGate > 0.0
-            ? clamp((spread / jitterGate - kGateOpens) / (1.0 - kGateOpens), 0.0, 1.0) : 0.0;
-        float draw = jitterGate > 0.0 ? mix(kSureDraw, kUnsureDraw, g) : 1.0;
+        float g = 0.0, draw = 1.0;  // ungated: the lobe itself, the drawn direction's footprint
+        if (jitterGate > 0.0) {
+            g = clamp((spread / jitterGate - kGateOpens) / (1.0 - kGateOpens), 0.0, 1.0);
+            draw = mix(kSureDraw, kUnsureDraw, g);
+        }
         vec3 d = lobeDirection(e, spread * draw, floor(objectPosition / jitterCell));
         return vec4(d, max(footprintSigma(d, footprintScale),
                            footprintSigma(e, kExitFootprint * g)));

@@ -13,18 +13,19 @@
 
 #include "common/bakefile.h"
 #include "support/cli_run.h"
+#include "support/files.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 
 using shrefract::test::CommandResult;
+using shrefract::test::kTetraOff;
 using shrefract::test::run;
 using shrefract::test::tmp;
 const auto& write = shrefract::test::writeText;
 
 const std::string kBake = SHREFRACT_BAKE_EXE;
-constexpr const char* kTetra = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
 // The tetrahedron with UVs: a net (face 0 in the middle, the other three folded out around it),
 // then the same with face 3's tip folded back onto face 0 (flipped), all four faces on one
 // triangle (overlapping), and a tip outside [0, 1].
@@ -73,34 +74,34 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"nan", "nan.off", "OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n", "", "nan.off"},
         BadCase{"cut", "cut.off", "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n", "",
                 "cut short: the header promises 4 vertices and 4 faces, the file ends after 2 faces"},
-        BadCase{"order", "tetra.off", kTetra, "--order 99", "order"},
-        BadCase{"rate", "tetra.off", kTetra, "--rate 0", "rate"},
-        BadCase{"grid", "tetra.off", kTetra, "--grid 3x5", "grid"},
-        BadCase{"gridtext", "tetra.off", kTetra, "--grid banana", "grid"},
-        BadCase{"ior", "tetra.off", kTetra, "--ior 0.5", "ior"},
-        BadCase{"precision", "tetra.off", kTetra, "--precision f64", "precision"},
+        BadCase{"order", "tetra.off", kTetraOff, "--order 99", "order"},
+        BadCase{"rate", "tetra.off", kTetraOff, "--rate 0", "rate"},
+        BadCase{"grid", "tetra.off", kTetraOff, "--grid 3x5", "grid"},
+        BadCase{"gridtext", "tetra.off", kTetraOff, "--grid banana", "grid"},
+        BadCase{"ior", "tetra.off", kTetraOff, "--ior 0.5", "ior"},
+        BadCase{"precision", "tetra.off", kTetraOff, "--precision f64", "precision"},
         BadCase{"scene", "scene.json", "{\"parts\": [{\"mesh\": \"tetra.off\", \"ior\": -2}]}", "", "scene.json"},
         BadCase{"gltfnoglass", "plain.gltf", "{\"asset\": {\"version\": \"2.0\"}}", "", "plain.gltf: no glass"},
         BadCase{"glbgarbage", "junk.glb", "glTF, but not binary glTF", "", "junk.glb: could not read glTF"},
-        BadCase{"layout", "tetra.off", kTetra, "--layout spiral", "--layout"},
-        BadCase{"chartrate", "tetra.off", kTetra, "--layout isolated --rate 2", "--rate is for --layout joining"},
-        BadCase{"texels", "tetra.off", kTetra, "--layout isolated --texels 0x5", "--texels"},
-        BadCase{"texelsjoin", "tetra.off", kTetra, "--texels 64", "--texels is for"},
-        BadCase{"uvnone", "tetra.off", kTetra, "--layout uv", "has no texture coordinates"},
+        BadCase{"layout", "tetra.off", kTetraOff, "--layout spiral", "--layout"},
+        BadCase{"chartrate", "tetra.off", kTetraOff, "--layout isolated --rate 2", "--rate is for --layout joining"},
+        BadCase{"texels", "tetra.off", kTetraOff, "--layout isolated --texels 0x5", "--texels"},
+        BadCase{"texelsjoin", "tetra.off", kTetraOff, "--texels 64", "--texels is for"},
+        BadCase{"uvnone", "tetra.off", kTetraOff, "--layout uv", "has no texture coordinates"},
         BadCase{"uvflipped", "tetra.obj", kTetraUvFlipped, "--layout uv", "flipped in UV space"},
         BadCase{"uvoverlap", "tetra.obj", kTetraUvOverlap, "--layout uv", "overlap in UV space"},
         BadCase{"uvoutside", "tetra.obj", kTetraUvOutside, "--layout uv", "outside [0, 1]"},
         // The tetrahedron's smallest model: 4 samples at rate 1, order 1 (3 stored coefficients)
         // in u8, 48 bytes; 0.00004 MB is 40.
-        BadCase{"budgetsmall", "tetra.off", kTetra, "--budget 0.00004", "order 1, rate 1, u8: 4.8e-05 MB"},
-        BadCase{"fitgrid", "tetra.off", kTetra, "--order 16 --grid 8x16", "--order 16 stores 153 coefficients, more than the 128 directions"},
-        BadCase{"budgettarget", "tetra.off", kTetra, "--budget 1 --target-error 5", "--target-error"},
-        BadCase{"budgetcharts", "tetra.off", kTetra, "--budget 1 --layout isolated", "--budget searches joining layouts only"},
-        BadCase{"budgetshard", "tetra.off", kTetra, "--budget 1 --shard 0/2", "--budget cannot be combined with --shard"},
-        BadCase{"basis", "tetra.off", kTetra, "--basis table", "--basis"},
-        BadCase{"gridorder", "tetra.off", kTetra, "--basis grid --order 8", "--order shapes an SH fit"},
-        BadCase{"gridbudget", "tetra.off", kTetra, "--basis grid --budget 0.0001", "grid basis 8x16, rate 1, u8"},
-        BadCase{"gridsize", "tetra.off", kTetra, "--basis grid --grid 32x128", "more than the 2048"}),
+        BadCase{"budgetsmall", "tetra.off", kTetraOff, "--budget 0.00004", "order 1, rate 1, u8: 4.8e-05 MB"},
+        BadCase{"fitgrid", "tetra.off", kTetraOff, "--order 16 --grid 8x16", "--order 16 stores 153 coefficients, more than the 128 directions"},
+        BadCase{"budgettarget", "tetra.off", kTetraOff, "--budget 1 --target-error 5", "--target-error"},
+        BadCase{"budgetcharts", "tetra.off", kTetraOff, "--budget 1 --layout isolated", "--budget searches joining layouts only"},
+        BadCase{"budgetshard", "tetra.off", kTetraOff, "--budget 1 --shard 0/2", "--budget cannot be combined with --shard"},
+        BadCase{"basis", "tetra.off", kTetraOff, "--basis table", "--basis"},
+        BadCase{"gridorder", "tetra.off", kTetraOff, "--basis grid --order 8", "--order shapes an SH fit"},
+        BadCase{"gridbudget", "tetra.off", kTetraOff, "--basis grid --budget 0.0001", "grid basis 8x16, rate 1, u8"},
+        BadCase{"gridsize", "tetra.off", kTetraOff, "--basis grid --grid 32x128", "more than the 2048"}),
     [](const auto& info) { return std::string(info.param.name); });
 
 // The chart layouts bake the test objects and say what they made.
@@ -125,7 +126,7 @@ TEST(BakeCli, ChartLayoutsBakeTheirObjects) {
 // samples; the tool says so on stderr with the chosen value (the tetrahedron has 10 unique samples
 // at rate 2, 20 at rate 3).
 TEST(BakeCli, SamplesRoundingIsReported) {
-    write(tmp("round_tetra.off"), kTetra);
+    write(tmp("round_tetra.off"), kTetraOff);
     const std::string out = tmp("round.shrefract.exr");
     CommandResult r = run(kBake + " " + tmp("round_tetra.off") + " -o " + out +
                           " --samples 12 --order 1 --grid 4x8 --cache '' -q");
@@ -142,7 +143,7 @@ TEST(BakeCli, SamplesRoundingIsReported) {
 // path (bake/fit.cpp) solves it: the bake succeeds, and the tool's own check that every weight
 // is finite (BakePlan::data) passed.
 TEST(BakeCli, RankDeficientWeightedFitStillBakes) {
-    write(tmp("aliased_tetra.off"), kTetra);
+    write(tmp("aliased_tetra.off"), kTetraOff);
     const std::string out = tmp("aliased.shrefract.exr");
     fs::remove(out);
     const CommandResult r = run(kBake + " " + tmp("aliased_tetra.off") + " -o " + out +
@@ -154,7 +155,7 @@ TEST(BakeCli, RankDeficientWeightedFitStillBakes) {
 // --search-only: the search's choice and the options that bake it, and no bake. Round trip: the
 // printed options, given to a bake, make the model the report chose.
 TEST(BakeCli, SearchOnlyPrintsTheOptionsThatBakeItsChoice) {
-    write(tmp("search_tetra.off"), kTetra);
+    write(tmp("search_tetra.off"), kTetraOff);
     const std::string report = tmp("search_report.json");
     fs::remove(report);
     CommandResult r = run(kBake + " " + tmp("search_tetra.off") + " --budget 0.002 --search-only --target-report " +
@@ -199,7 +200,7 @@ TEST(BakeCli, SearchOnlyPrintsTheOptionsThatBakeItsChoice) {
 }
 
 TEST(BakeCli, MissingOutputFolderIsAnErrorBeforeAnyWork) {
-    write(tmp("nodir_tetra.off"), kTetra);
+    write(tmp("nodir_tetra.off"), kTetraOff);
     CommandResult r = run(kBake + " " + tmp("nodir_tetra.off") + " -o " + tmp("no/such/dir/x.shrefract.exr") + " -q");
     EXPECT_NE(r.code, 0);
     EXPECT_NE(r.out.find("does not exist"), std::string::npos) << r.out;

@@ -16,7 +16,6 @@
 namespace shrefract {
 namespace {
 
-const char* kTetra = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
 
 struct Case {
     Subdivision scheme;
@@ -29,7 +28,7 @@ struct Case {
 // tetrahedron (V 4, E 6, T 4).
 TEST(Subdivide, CountsFollowTheSchemesAndTheMeshStaysClosed) {
     const std::string in = test::tmp("subdivide_tetra.off");
-    test::writeText(in, kTetra);
+    test::writeText(in, test::kTetraOff);
     for (const Case& c : {Case{Subdivision::Loop, 1, 10, 16}, Case{Subdivision::Loop, 2, 34, 64},
                           Case{Subdivision::Sqrt3, 1, 8, 12}, Case{Subdivision::Sqrt3, 2, 20, 36}}) {
         const std::string out = test::tmp("subdivide_out.off");
@@ -69,7 +68,7 @@ TEST(Subdivide, BadInputIsRefusedByNameAndWritesNothing) {
 TEST(Subdivide, TheOutputIsStagedAndALinkIsNeverReplaced) {
     const std::filesystem::path dir = test::scratchFolder("subdivide");
     const std::string in = (dir / "tetra.off").string();
-    test::writeText(in, kTetra);
+    test::writeText(in, test::kTetraOff);
     const std::string precious = (dir / "precious.off").string();
     test::writeText(precious, "precious");
     const std::string link = (dir / "link.off").string();

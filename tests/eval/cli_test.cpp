@@ -9,11 +9,13 @@
 #include "common/evalbuffer.h"
 #include "eval/image_eval.h"
 #include "support/cli_run.h"
+#include "support/files.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 using shrefract::test::CommandResult;
+using shrefract::test::kTetraOff;
 using shrefract::test::run;
 using shrefract::test::tmp;
 const auto& write = shrefract::test::writeText;
@@ -21,12 +23,11 @@ const auto& write = shrefract::test::writeText;
 const std::string kBake = SHREFRACT_BAKE_EXE;
 const std::string kEval = SHREFRACT_EVAL_EXE;
 const std::string kRender = SHREFRACT_RENDER_EXE;
-constexpr const char* kTetra = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
 
 // A whole small bake, then the evaluation tools on it: the error table, and query answers
 // agreeing with the table's decompression at sample positions.
 TEST(EvalCli, BakesAndEvaluatesATetrahedron) {
-    write(tmp("full_tetra.off"), kTetra);
+    write(tmp("full_tetra.off"), kTetraOff);
     std::string out = tmp("tetra.shrefract.exr");
     fs::remove(out);
     CommandResult b = run(kBake + " " + tmp("full_tetra.off") + " -o " + out + " --rate 2 --grid 8x16 --order 4 --cache ''");

@@ -34,6 +34,11 @@ inline void writeFile(const std::filesystem::path& p, const std::string& bytes) 
     std::ofstream(p, std::ios::binary) << bytes;
 }
 
+// The tetrahedron (0,0,0), (1,0,0), (0,1,0), (0,0,1) as an OFF file, its faces turned outward: the
+// smallest closed mesh the tools accept.
+inline constexpr const char* kTetraOff =
+    "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+
 // Every name in `dir` (no recursion), sorted.
 inline std::set<std::string> listing(const std::filesystem::path& dir) {
     std::set<std::string> names;

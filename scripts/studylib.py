@@ -5,7 +5,6 @@ Python standard library only.
 import glob
 import hashlib
 import json
-import math
 import os
 import subprocess
 import sys
@@ -185,19 +184,15 @@ class Tools:
 
 
 def summary(r):
-    """The numbers a table shows of one comparison."""
+    """The numbers a table shows of one comparison: the exit's angular error, the frame's PSNR and
+    SSIM, and the object's own (over the pixels the reference covers: PSNR, SSIM, LDR-FLIP and the
+    detail ratio; docs/evaluation.md "Object metrics")."""
     a = r["angleDeg"]
-    out = {"median": a.get("median"), "p95": a.get("p95"), "mean": a.get("mean"),
-           "psnr": r["psnr"], "ssim": r["ssim"], "mismatch": r["coverage"]["mismatch"],
-           "covered": r["coverage"]["ref"]}
-    # PSNR over the object's pixels alone: the background is the same environment lookup in both
-    # (identical to 125 dB) except at a multi-sample reference's anti-aliased silhouette, so the
-    # squared error is the object's and MSE_object = MSE_frame * pixels / covered. The frame's PSNR also measures how much of the
-    # frame the object fills; this one does not.
-    pixels = r.get("pixels") or (r.get("width", 0) * r.get("height", 0))
-    if pixels and out["covered"]:
-        out["psnrObject"] = r["psnr"] - 10.0 * math.log10(pixels / out["covered"])
-    return out
+    return {"median": a.get("median"), "p95": a.get("p95"), "mean": a.get("mean"),
+            "psnr": r["psnr"], "ssim": r["ssim"], "mismatch": r["coverage"]["mismatch"],
+            "covered": r["coverage"]["ref"], "objectPsnr": r.get("objectPsnr"),
+            "objectSsim": r.get("objectSsim"), "objectFlip": r.get("objectFlip"),
+            "detailRatio": r.get("detailRatio")}
 
 
 def write_section(name, owner, body):

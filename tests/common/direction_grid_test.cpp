@@ -17,6 +17,7 @@
 
 #include "common/error.h"
 #include "common/sh.h"
+#include "support/random_direction.h"
 
 namespace shrefract {
 namespace {
@@ -25,14 +26,6 @@ constexpr double kPi = 3.14159265358979323846;
 
 glm::dvec3 fromAngles(double theta, double phi) {
     return {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
-}
-
-glm::dvec3 randomDirection(std::mt19937_64& rng) {
-    std::normal_distribution<double> n;
-    glm::dvec3 v;
-    do v = {n(rng), n(rng), n(rng)};
-    while (glm::length(v) < 1e-6);
-    return glm::normalize(v);
 }
 
 double interpolateValues(const DirectionGrid& g, const std::vector<double>& f, glm::dvec3 w) {
@@ -123,7 +116,7 @@ TEST(DirectionGrid, InterpolationWeightsSumToOne) {
     DirectionGrid g{8, 16};
     std::mt19937_64 rng(1);
     for (int n = 0; n < 5000; ++n) {
-        glm::dvec3 w = randomDirection(rng);
+        glm::dvec3 w = test::randomDirection(rng);
         int idx[4];
         double wt[4];
         int k = g.interpolate(w, idx, wt);

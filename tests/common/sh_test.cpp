@@ -2,6 +2,7 @@
 // the sign convention, even-parity storage and the band filter.
 #include "common/direction_grid.h"
 #include "common/sh.h"
+#include "support/random_direction.h"
 
 #include <gtest/gtest.h>
 
@@ -15,15 +16,6 @@ namespace shrefract {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-glm::dvec3 randomDirection(std::mt19937_64& rng) {
-    std::normal_distribution<double> n;
-    glm::dvec3 v;
-    do v = {n(rng), n(rng), n(rng)};
-    while (glm::length(v) < 1e-6);
-    return glm::normalize(v);
-}
-
 
 // Sphere quadrature: Gauss-Legendre in z (nz nodes, exact to degree 2 nz - 1) times the
 // trapezoid rule in phi (nPhi points, exact for trigonometric degree < nPhi). Calls f(w, weight).
@@ -96,7 +88,7 @@ TEST(SH, OrthonormalByQuadrature) {
 TEST(SH, PolynomialMatchesRecurrence) {
     std::mt19937_64 rng(7);
     std::vector<glm::dvec3> dirs(2000);
-    for (auto& d : dirs) d = randomDirection(rng);
+    for (auto& d : dirs) d = test::randomDirection(rng);
     // Include the poles and the equator.
     dirs.push_back({0, 0, 1});
     dirs.push_back({0, 0, -1});
@@ -128,7 +120,7 @@ TEST(SH, PolynomialMatchesRecurrence) {
 TEST(SH, SignConventionAgainstClosedForms) {
     std::mt19937_64 rng(3);
     for (int n = 0; n < 50; ++n) {
-        glm::dvec3 w = randomDirection(rng);
+        glm::dvec3 w = test::randomDirection(rng);
         double x = w.x, y = w.y, z = w.z;
         const double c1 = std::sqrt(3.0 / (4.0 * kPi));
         struct Case {
@@ -213,7 +205,7 @@ TEST(SH, EvalEvenMatchesRecurrence) {
     std::vector<double> ref(shCount(L));
     double worst = 0.0;
     for (int n = 0; n < 500; ++n) {
-        glm::dvec3 w = n == 0 ? glm::dvec3(0, 0, 1) : randomDirection(rng);
+        glm::dvec3 w = n == 0 ? glm::dvec3(0, 0, 1) : test::randomDirection(rng);
         shEvalEven(L, glm::vec3(w), out.data());
         shEvalAllRecurrence(L, glm::dvec3(glm::vec3(w)), ref.data());
         for (const ShLM& f : shEvenFunctions(L)) {
@@ -230,7 +222,7 @@ TEST(SH, EvalAllMatchesSingle) {
     std::mt19937_64 rng(5);
     std::vector<double> all(shCount(L));
     for (int n = 0; n < 20; ++n) {
-        glm::dvec3 w = randomDirection(rng);
+        glm::dvec3 w = test::randomDirection(rng);
         shEvalAllRecurrence(L, w, all.data());
         for (int l = 0; l <= L; ++l)
             for (int m = -l; m <= l; ++m)

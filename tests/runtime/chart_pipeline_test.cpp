@@ -63,13 +63,7 @@ TEST_P(ChartGl, DecompressionEqualsCpuAtEveryCoveredTexel) {
         const BakeData data = test::randomBake(chartLayout("scenes/vase.obj", kind, 3000, 2), 4);
         auto r = refractor(makeBake(data));
         for (glm::vec3 eye : {glm::vec3(0.3f, 0.8f, 3.0f), glm::vec3(-2.5f, -1.0f, 0.4f)}) {
-            r->update(FrameView::fromEye(eye));
-            const std::vector<float> gl = r->readDirectionalMap();
-            float worst = 0;
-            for (int i = 0; i < data.layout.sampleCount(); ++i) {
-                const glm::vec4 cpu = decompressSample(data, i, localViewFromEye(data.layout, i, eye));
-                for (int c = 0; c < 4; ++c) worst = std::max(worst, std::abs(gl[4 * i + c] - cpu[c]));
-            }
+            const float worst = test::worstAgainstCpu(*r, data, eye);
             std::printf("[%s] %s: max |GL - CPU| = %.3g over %d texels\n", nameOf(GetParam()),
                         nameOf(kind), worst, data.layout.sampleCount());
             // Measured 1e-5..4e-5: the view vector interpolated from the vertices in float, where

@@ -109,14 +109,7 @@ TEST_P(ErrorFoldTest, BakesWithoutAModelDecompressAsBefore) {
     const BakeData data = test::randomBake(4, 3, 5);  // errorOrder -1
     auto r = make(makeBake(data), "rho", true);
     const glm::vec3 eye(-1.5f, 0.3f, 2.0f);
-    r->update(FrameView::fromEye(eye));
-    const std::vector<float> gl = r->readDirectionalMap();
-    float worst = 0;
-    for (int i = 0; i < data.layout.sampleCount(); ++i) {
-        const glm::vec4 cpu = decompressSample(data, i, localViewFromEye(data.layout, i, eye));
-        for (int c = 0; c < 4; ++c) worst = std::max(worst, std::abs(gl[4 * i + c] - cpu[c]));
-    }
-    EXPECT_LT(worst, 1e-4f);  // as GlTest.DecompressionEqualsCpuAtEveryMuSample's bound
+    EXPECT_LT(test::worstAgainstCpu(*r, data, eye), 1e-4f);  // as GlTest.DecompressionEqualsCpuAtEveryMuSample's bound
 }
 
 // An environment whose linear colour is (d + 1) / 2 along d, so that a pixel's colour says which

@@ -27,18 +27,6 @@ protected:
     }
 };
 
-// max over samples and channels of |GL - CPU| for D_mu.
-float maxDecompressionError(Refractor& r, const BakeData& d, glm::vec3 eye, int order) {
-    r.update(FrameView::fromEye(eye));
-    std::vector<float> gl = r.readDirectionalMap();
-    float worst = 0;
-    for (int i = 0; i < d.layout.sampleCount(); ++i) {
-        glm::vec4 cpu = decompressSample(d, i, localViewFromEye(d.layout, i, eye), order);
-        for (int c = 0; c < 4; ++c) worst = std::max(worst, std::abs(gl[4 * i + c] - cpu[c]));
-    }
-    return worst;
-}
-
 TEST_P(GlTest, DecompressionEqualsCpuAtEveryMuSample) {
     for (int order : {2, 4, 8}) {
         BakeData data = test::randomBake(order, 3);
@@ -46,7 +34,7 @@ TEST_P(GlTest, DecompressionEqualsCpuAtEveryMuSample) {
         for (const char* preset : {"modern", "2006"}) {
             auto r = refractor(bake, preset);
             for (glm::vec3 eye : {glm::vec3(0.3f, 0.8f, 3.0f), glm::vec3(-2.5f, -1.0f, 0.4f)}) {
-                float err = maxDecompressionError(*r, data, eye, order);
+                float err = test::worstAgainstCpu(*r, data, eye, order);
                 std::printf("[%s] order %d preset %s passes %d: max |GL - CPU| = %.3g\n",
                             nameOf(GetParam()), order, preset, r->passCount(), err);
                 EXPECT_LT(err, 1e-4f) << preset << " order " << order;
@@ -54,7 +42,7 @@ TEST_P(GlTest, DecompressionEqualsCpuAtEveryMuSample) {
             // Progressive decompression: a lower order on the fly.
             r->setOrder(1);
             EXPECT_EQ(r->order(), 1);
-            EXPECT_LT(maxDecompressionError(*r, data, glm::vec3(1, 2, 2), 1), 1e-4f);
+            EXPECT_LT(test::worstAgainstCpu(*r, data, glm::vec3(1, 2, 2), 1), 1e-4f);
             // -1 means every band, as RefractorOptions::order = -1 does; above the stored order
             // clamps to it; below -1 is refused.
             r->setOrder(-1);
@@ -243,7 +231,7 @@ TEST_P(GlTest, HalfPrecisionBakesUseHalfTheWeightMemory) {
     auto r32 = refractor(full), r16 = refractor(half);
     EXPECT_EQ(r16->memory().weights * 2, r32->memory().weights);
     const glm::vec3 eye(0.3f, 0.8f, 3.0f);
-    float err = maxDecompressionError(*r16, data, eye, 8);
+    float err = test::worstAgainstCpu(*r16, data, eye, 8);
     std::printf("[%s] RGBA16F weights: max |GL - CPU| = %.3g\n", nameOf(GetParam()), err);
     EXPECT_LT(err, 0.05f);
     EXPECT_GT(err, 1e-6f);  // it really is half precision, not float

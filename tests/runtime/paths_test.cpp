@@ -38,19 +38,6 @@ std::vector<float> sky(int w, int h) {
     return rgb;
 }
 
-// The largest |GL - CPU| over every sample's D (x, y, z, length) for a viewer at `eye`: the
-// runtime's texture-space decompression read back against common/decompress.h.
-float worstAgainstCpu(Refractor& r, const BakeData& data, glm::vec3 eye) {
-    r.update(FrameView::fromEye(eye));
-    const std::vector<float> gl = r.readDirectionalMap();
-    float worst = 0;
-    for (int i = 0; i < data.layout.sampleCount(); ++i) {
-        const glm::vec4 cpu = decompressSample(data, i, localViewFromEye(data.layout, i, eye));
-        for (int c = 0; c < 4; ++c) worst = std::max(worst, std::abs(gl[4 * i + c] - cpu[c]));
-    }
-    return worst;
-}
-
 class Paths : public test::HeadlessTest {
 protected:
     std::unique_ptr<Refractor> make(const Bake& bake, const std::string& path,
@@ -162,7 +149,7 @@ TEST_P(Paths, EightBitWeightsStayEightBitOnTheGpu) {
     const glm::vec3 eye(0.3f, 0.8f, 3.0f);
     for (const char* dec : {"vertex", "texture"}) {
         auto r = make(bake, "direct", dec);
-        const float worst = worstAgainstCpu(*r, read, eye);
+        const float worst = test::worstAgainstCpu(*r, read, eye);
         std::printf("[%s] u8 as RGBA8, %s decompression: max |GL - CPU| = %.3g\n", nameOf(GetParam()), dec, worst);
         EXPECT_LT(worst, 1e-4f) << dec;
         const size_t texels = size_t(read.layout.muWidth) * read.layout.muHeight;
@@ -194,7 +181,7 @@ TEST_P(Paths, GridBasisMatchesTheCpuInterpolation) {
             for (const auto& [pathName, dec] : {std::pair{"direct", "vertex"}, std::pair{"direct", "texture"},
                                                  std::pair{"rho", "auto"}}) {
                 auto r = make(bake, pathName, dec);
-                const float worst = worstAgainstCpu(*r, read, eye);
+                const float worst = test::worstAgainstCpu(*r, read, eye);
                 std::printf("[%s] grid 8x16 %s, %s %s, eye (%g, %g, %g): max |GL - CPU| = %.3g\n",
                             nameOf(GetParam()), nameOf(p), pathName, dec, eye.x, eye.y, eye.z, worst);
                 EXPECT_LT(worst, 1e-4f) << nameOf(p) << " " << pathName << " " << dec;

@@ -3,12 +3,17 @@
 // pipeline reproduces the CPU decompressor, whatever the weights are.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <random>
+#include <vector>
 
 #include "bake/joining_layout.h"
 #include "common/bakefile.h"
+#include "common/decompress.h"
 #include "common/scene.h"
 #include "common/sh.h"
+#include "shrefract/runtime.h"
 
 namespace shrefract::test {
 
@@ -73,6 +78,20 @@ inline BakeData randomGridBake(DirectionGrid grid, int rate, unsigned seed = 7) 
     for (float& w : d.weights) w = u(rng);
     for (size_t t = 0; t < size_t(grid.count()) * n; ++t) d.weights[t * 4 + 2] += 2.0f, d.weights[t * 4 + 3] += 1.0f;
     return d;
+}
+
+// Updates `r` for `eye` and reads its directional map back (RGBA per mu sample): the largest
+// |GL - CPU| over every sample and channel, against the CPU decompressor at the same eye, bands
+// 0..order (-1: all).
+inline float worstAgainstCpu(Refractor& r, const BakeData& data, glm::vec3 eye, int order = -1) {
+    r.update(FrameView::fromEye(eye));
+    const std::vector<float> gl = r.readDirectionalMap();
+    float worst = 0;
+    for (int i = 0; i < data.layout.sampleCount(); ++i) {
+        const glm::vec4 cpu = decompressSample(data, i, localViewFromEye(data.layout, i, eye), order);
+        for (int c = 0; c < 4; ++c) worst = std::max(worst, std::abs(gl[4 * i + c] - cpu[c]));
+    }
+    return worst;
 }
 
 }  // namespace shrefract::test

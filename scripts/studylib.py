@@ -186,7 +186,7 @@ class Tools:
 def summary(r):
     """The numbers a table shows of one comparison: the exit's angular error, the frame's PSNR and
     SSIM, and the object's own (over the pixels the reference covers: PSNR, SSIM, LDR-FLIP and the
-    detail ratio; docs/evaluation.md "Object metrics")."""
+    detail ratio; docs/evaluation.md "Object metrics and FLIP")."""
     a = r["angleDeg"]
     return {"median": a.get("median"), "p95": a.get("p95"), "mean": a.get("mean"),
             "psnr": r["psnr"], "ssim": r["ssim"], "mismatch": r["coverage"]["mismatch"],

@@ -16,7 +16,6 @@
 namespace shrefract {
 namespace {
 
-
 struct Case {
     Subdivision scheme;
     int steps;

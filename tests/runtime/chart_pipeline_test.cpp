@@ -10,7 +10,6 @@
 
 #include "bake_data.h"
 #include "bake/chart_layout.h"
-#include "common/decompress.h"
 #include "common/error.h"
 #include "common/sh.h"
 #include "gl.h"

@@ -109,7 +109,8 @@ TEST_P(ErrorFoldTest, BakesWithoutAModelDecompressAsBefore) {
     const BakeData data = test::randomBake(4, 3, 5);  // errorOrder -1
     auto r = make(makeBake(data), "rho", true);
     const glm::vec3 eye(-1.5f, 0.3f, 2.0f);
-    EXPECT_LT(test::worstAgainstCpu(*r, data, eye), 1e-4f);  // as GlTest.DecompressionEqualsCpuAtEveryMuSample's bound
+    // The bound is GlTest.DecompressionEqualsCpuAtEveryMuSample's.
+    EXPECT_LT(test::worstAgainstCpu(*r, data, eye), 1e-4f);
 }
 
 // An environment whose linear colour is (d + 1) / 2 along d, so that a pixel's colour says which

@@ -6,7 +6,6 @@
 #include <map>
 
 #include "bake_data.h"
-#include "common/decompress.h"
 #include "common/error.h"
 #include "shrefract/context.h"
 #include "shrefract/render.h"

@@ -9,7 +9,6 @@
 #include <filesystem>
 
 #include "bake_data.h"
-#include "common/decompress.h"
 #include "common/error.h"
 #include "common/latlong.h"
 #include "common/prefilter.h"

@@ -208,11 +208,11 @@ struct RefractorOptions {
     float spreadScale = 0.15f;      // lobe width factor on the predicted error (docs/runtime.md)
     float footprintScale = 0.15f;   // screen-space footprint factor
     // Blend: the sharp lookup and the spread lobe mixed, the lobe's share sigma / (sigma +
-    // blendSigma) for a lobe sigma radians wide (docs/runtime.md "Blend shading").
+    // blendSigma) for a lobe sigma radians wide (docs/runtime.md "Spread and blend").
     float blendSigma = 0.1f;
     // Jitter: one direction drawn from the spread lobe per cell of this size (a fraction of the
     // object's bounding-box diagonal; about two pixels where the object spans 400), the same in
-    // every frame, instead of the lobe's mean (docs/runtime.md "Jitter shading").
+    // every frame, instead of the lobe's mean (docs/runtime.md "Jitter").
     float jitterCell = 0.005f;
     // Jitter, gated by the lobe's width: at lobes this wide (radians) and wider, the draw is twice
     // the lobe and the lookup takes at least 0.4 of a pixel's turn of the exit; below 0.6 of it,

@@ -262,22 +262,54 @@ glm::vec2 closestBarycentric(glm::vec3 p, glm::vec3 a, glm::vec3 b, glm::vec3 c,
     return best;
 }
 
+// Refuses query q unless its point lies within maxDistance of the surface (distance: to the
+// nearest triangle, corners a, b, c, counter-clockwise seen from outside, their shading normals
+// summing to ns) and its view direction w does not point into the surface there.
+void refuseOffSurface(size_t q, glm::vec3 p, glm::vec3 w, float distance, float maxDistance,
+                      glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 ns) {
+    if (!(distance <= maxDistance)) {
+        std::ostringstream os;
+        os << "point (" << p.x << ", " << p.y << ", " << p.z << ") is " << distance
+           << " from the surface (at most " << maxDistance << ")";
+        throw QueryRefused(q, os.str());
+    }
+    // The outward geometric normal, turned to agree with the corners' shading normals.
+    glm::vec3 n = glm::cross(b - a, c - a);
+    if (glm::dot(n, ns) < 0.0f) n = -n;
+    n = glm::normalize(n);
+    if (glm::dot(glm::normalize(w), n) < -1e-4f) {
+        std::ostringstream os;
+        os << "view direction (" << w.x << ", " << w.y << ", " << w.z
+           << ") points into the surface (its normal there is (" << n.x << ", " << n.y << ", "
+           << n.z << "))";
+        throw QueryRefused(q, os.str());
+    }
+}
+
 // A chart bake: the nearest triangle of the unfolded mesh gives the point's atlas UV, the map
 // there is the runtime's (the bake's gutter, seam-aware), built by the CPU twin from the samples
 // that can reach the bilinear lookup (a window of gutter + 2 texels and its seam sources).
-glm::vec4 queryChart(const BakeData& bake, glm::vec3 p, glm::vec3 omega) {
+// Refuses as refuseOffSurface does.
+glm::vec4 queryChart(const BakeData& bake, size_t q, glm::vec3 p, glm::vec3 w, float maxDistance) {
     const SurfaceLayout& L = bake.layout;
     const ChartAtlas& A = L.atlas;
     float bestD = std::numeric_limits<float>::max();
     glm::vec2 uv(0.0f);
+    const glm::uvec3* best = nullptr;
     for (const glm::uvec3& t : A.triangles) {
         float d2;
         const glm::vec2 b = closestBarycentric(p, A.vertexPosition[t[0]], A.vertexPosition[t[1]],
                                                A.vertexPosition[t[2]], &d2);
         if (d2 >= bestD) continue;
-        bestD = d2;
+        bestD = d2, best = &t;
         uv = (1 - b.x - b.y) * A.vertexUV[t[0]] + b.x * A.vertexUV[t[1]] + b.y * A.vertexUV[t[2]];
     }
+    if (!best) throw QueryRefused(q, "the bake has no triangles");
+    const glm::uvec3& t = *best;
+    refuseOffSurface(q, p, w, std::sqrt(bestD), maxDistance, A.vertexPosition[t[0]],
+                     A.vertexPosition[t[1]], A.vertexPosition[t[2]],
+                     A.vertexNormal[t[0]] + A.vertexNormal[t[1]] + A.vertexNormal[t[2]]);
+    const glm::vec3 omega = glm::normalize(w);
     const int W = L.muWidth, reach = A.gutter + 2;
     const glm::ivec2 c(int(uv.x * W), int(uv.y * L.muHeight));
     std::vector<int> sampleAt(size_t(W) * L.muHeight, -1);
@@ -311,21 +343,21 @@ std::vector<glm::vec4> queryBake(const BakeData& bake, const std::vector<glm::ve
                                  const std::vector<glm::vec3>& w, float maxDistance) {
     SHREFRACT_CHECK_EQ(p.size(), w.size());
     const SurfaceLayout& L = bake.layout;
+    if (maxDistance < 0.0f && !L.position.empty()) {
+        glm::vec3 lo = L.position[0], hi = L.position[0];
+        for (const glm::vec3& x : L.position) lo = glm::min(lo, x), hi = glm::max(hi, x);
+        maxDistance = kQueryDistance * glm::length(hi - lo);
+    }
     if (L.isChartLayout()) {
         std::vector<glm::vec4> out(p.size());
         for (size_t q = 0; q < p.size(); ++q) {
-            const glm::vec4 d = queryChart(bake, p[q], glm::normalize(w[q]));
+            const glm::vec4 d = queryChart(bake, q, p[q], w[q], maxDistance);
             const glm::vec3 e(d);
             out[q] = glm::vec4(glm::length(e) > 0 ? e / glm::length(e) : e, d.w);
         }
         return out;
     }
     const int r = L.rate;
-    if (maxDistance < 0.0f && !L.position.empty()) {
-        glm::vec3 lo = L.position[0], hi = L.position[0];
-        for (const glm::vec3& x : L.position) lo = glm::min(lo, x), hi = glm::max(hi, x);
-        maxDistance = kQueryDistance * glm::length(hi - lo);
-    }
     std::vector<glm::vec4> values(L.sampleCount(), glm::vec4(0.0f));
     std::vector<glm::vec4> out(p.size());
     for (size_t q = 0; q < p.size(); ++q) {
@@ -340,26 +372,11 @@ std::vector<glm::vec4> queryBake(const BakeData& bake, const std::vector<glm::ve
             if (d2 < bestD) bestD = d2, bestT = t, bestUV = uv;
         }
         if (bestT < 0) throw QueryRefused(q, "the bake has no triangles");
-        const float distance = std::sqrt(bestD);
-        if (!(distance <= maxDistance)) {
-            std::ostringstream os;
-            os << "point (" << p[q].x << ", " << p[q].y << ", " << p[q].z << ") is " << distance
-               << " from the surface (at most " << maxDistance << ")";
-            throw QueryRefused(q, os.str());
-        }
-        // The outward geometric normal, turned to agree with the corners' shading normals.
         const uint32_t s0 = L.sampleAt(bestT, 0, 0), s1 = L.sampleAt(bestT, r, 0),
                        s2 = L.sampleAt(bestT, 0, r);
-        glm::vec3 n = glm::cross(L.position[s1] - L.position[s0], L.position[s2] - L.position[s0]);
-        if (glm::dot(n, L.normal[s0] + L.normal[s1] + L.normal[s2]) < 0.0f) n = -n;
+        refuseOffSurface(q, p[q], w[q], std::sqrt(bestD), maxDistance, L.position[s0], L.position[s1],
+                         L.position[s2], L.normal[s0] + L.normal[s1] + L.normal[s2]);
         const glm::vec3 omega = glm::normalize(w[q]);
-        if (glm::dot(omega, glm::normalize(n)) < -1e-4f) {
-            std::ostringstream os;
-            os << "view direction (" << w[q].x << ", " << w[q].y << ", " << w[q].z
-               << ") points into the surface (its normal there is (" << glm::normalize(n).x << ", "
-               << glm::normalize(n).y << ", " << glm::normalize(n).z << "))";
-            throw QueryRefused(q, os.str());
-        }
         for (int j = 0; j <= r; ++j)
             for (int i = 0; i + j <= r; ++i) {
                 uint32_t s = L.sampleAt(bestT, i, j);

@@ -48,10 +48,10 @@ struct QueryRefused : InputError {
 // nearest triangle exactly as the rho layout does (interpolateRho); for chart bakes looked up in
 // the atlas as the runtime's refraction map holds it (chartRefractionMap: the bake's gutter,
 // seam-aware). Viewer at infinity along w.
-// Refuses (QueryRefused) a point farther than `maxDistance` from the surface (object units; < 0:
-// kQueryDistance of the bake's bounding-box diagonal) and a view direction below the surface
-// there (w . n < -1e-4 |w|, n the nearest triangle's outward geometric normal): the bake knows
-// nothing there, and an answer would look as good as any other.
+// Refuses (QueryRefused), on either layout, a point farther than `maxDistance` from the surface
+// (object units; < 0: kQueryDistance of the samples' bounding-box diagonal) and a view direction
+// below the surface there (w . n < -1e-4 |w|, n the nearest triangle's outward geometric normal):
+// the bake knows nothing there, and an answer would look as good as any other.
 constexpr float kQueryDistance = 1e-3f;
 std::vector<glm::vec4> queryBake(const BakeData& bake, const std::vector<glm::vec3>& p,
                                  const std::vector<glm::vec3>& w, float maxDistance = -1.0f);

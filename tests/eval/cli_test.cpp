@@ -24,6 +24,19 @@ const std::string kBake = SHREFRACT_BAKE_EXE;
 const std::string kEval = SHREFRACT_EVAL_EXE;
 const std::string kRender = SHREFRACT_RENDER_EXE;
 
+// Queries `bake` with the rows `csv` (written to NAME.csv): refused with exit 2, the message
+// "NAME.csv: WHAT", and no answer file.
+void expectQueryRefused(const std::string& bake, const std::string& name, const std::string& csv,
+                        const std::string& what) {
+    const std::string in = tmp(name + ".csv"), answers = tmp(name + "_a.csv");
+    write(in, csv);
+    fs::remove(answers);
+    CommandResult r = run(kEval + " query " + bake + " --in " + in + " --out " + answers);
+    EXPECT_EQ(r.code, 2) << r.out;
+    EXPECT_NE(r.out.find(in + ": " + what), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(answers));
+}
+
 // A whole small bake, then the evaluation tools on it: the error table, and query answers
 // agreeing with the table's decompression at sample positions.
 TEST(EvalCli, BakesAndEvaluatesATetrahedron) {
@@ -58,18 +71,10 @@ TEST(EvalCli, BakesAndEvaluatesATetrahedron) {
 
     // A point 5 units off the surface, and a direction into the surface, are refused with the
     // line named (the bake knows nothing there); a point within --max-distance is answered.
-    const std::pair<std::string, std::string> refused[] = {
-        {"px,py,pz,wx,wy,wz\n0.2,0.2,0,0,0,-1\n0.2,0.2,-5,0,0,-1\n",
-         "line 3: point (0.2, 0.2, -5) is 5 from the surface"},
-        {"0.2,0.2,0,0,0,-1\n\n0.2,0.2,0,0.1,0,1\n", "line 3: view direction (0.1, 0, 1) points into the surface"},
-    };
-    for (const auto& [csv, what] : refused) {
-        write(tmp("off.csv"), csv);
-        CommandResult r = run(kEval + " query " + out + " --in " + tmp("off.csv") + " --out " + tmp("off_a.csv"));
-        EXPECT_EQ(r.code, 2) << r.out;
-        EXPECT_NE(r.out.find(tmp("off.csv") + ": " + what), std::string::npos) << r.out;
-        EXPECT_FALSE(fs::exists(tmp("off_a.csv")));
-    }
+    expectQueryRefused(out, "off", "px,py,pz,wx,wy,wz\n0.2,0.2,0,0,0,-1\n0.2,0.2,-5,0,0,-1\n",
+                       "line 3: point (0.2, 0.2, -5) is 5 from the surface");
+    expectQueryRefused(out, "off", "0.2,0.2,0,0,0,-1\n\n0.2,0.2,0,0.1,0,1\n",
+                       "line 3: view direction (0.1, 0, 1) points into the surface");
     write(tmp("near.csv"), "0.2,0.2,-0.01,0,0,-1\n");
     CommandResult near = run(kEval + " query " + out + " --in " + tmp("near.csv") + " --out " + tmp("near_a.csv"));
     EXPECT_EQ(near.code, 2) << near.out;  // 0.01 off: beyond 0.001 of the diagonal (1.7e-3)
@@ -81,6 +86,25 @@ TEST(EvalCli, BakesAndEvaluatesATetrahedron) {
     CommandResult o = run(kEval + " directions " + out + " --pairs 10 --order 5");
     EXPECT_EQ(o.code, 2) << o.out;
     EXPECT_NE(o.out.find("--order 5: " + out + " stores orders 0..4"), std::string::npos) << o.out;
+}
+
+// A chart bake (its atlas, not the joining grid) refuses the same queries: a point off the surface
+// and a view direction into it, with the line named; a point on it is answered.
+TEST(EvalCli, ChartBakeQueriesAreRefusedOffTheSurface) {
+    write(tmp("chart_tetra.off"), kTetraOff);
+    const std::string out = tmp("chart_tetra.shrefract.exr");
+    fs::remove(out);
+    CommandResult b = run(kBake + " " + tmp("chart_tetra.off") + " -o " + out +
+                          " --layout isolated --samples 300 --grid 8x16 --order 4 --cache ''");
+    ASSERT_EQ(b.code, 0) << b.out;
+    expectQueryRefused(out, "chart_off", "0.2,0.2,-5,0,0,-1\n", "line 1: point (0.2, 0.2, -5) is 5 from the surface");
+    expectQueryRefused(out, "chart_off", "0.2,0.2,0,0,0,-1\n0.2,0.2,0,0.1,0,1\n",
+                       "line 2: view direction (0.1, 0, 1) points into the surface");
+    write(tmp("chart_on.csv"), "0.2,0.2,0,0,0,-1\n");
+    fs::remove(tmp("chart_on_a.csv"));
+    CommandResult on = run(kEval + " query " + out + " --in " + tmp("chart_on.csv") + " --out " + tmp("chart_on_a.csv"));
+    EXPECT_EQ(on.code, 0) << on.out;
+    EXPECT_TRUE(fs::exists(tmp("chart_on_a.csv")));
 }
 
 // One exit-code table for every tool (README "Exit codes"): 0 for --help and --version (which names

@@ -163,7 +163,7 @@ TEST(Stability, SphereWhisperingGallery) {
 }
 
 TEST(Stability, BeadInShell) {
-    CaseResult r = runCase("bead_in_shell", "glass shell (r 1, 0.9) around a bead (r 0.4): depth complexity 4",
+    CaseResult r = runCase("bead_in_shell", "glass shell (r 1, 0.9) around a bead (r 0.4): depth complexity 6",
                            load("scenes/bead_in_shell.json"), small());
     expectMedianNear(r, 1.77);
 }

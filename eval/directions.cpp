@@ -198,35 +198,6 @@ double spearman(const std::vector<double>& a, const std::vector<double>& b) {
     return saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 0.0;
 }
 
-std::vector<int> adaptiveOrders(const BakeData& bake, double toleranceDeg) {
-    const int n = bake.layout.sampleCount();
-    // 64 directions spread over the hemisphere (a Fibonacci spiral in z = cos(theta)).
-    std::vector<glm::vec3> dirs;
-    for (int k = 0; k < 64; ++k) {
-        float z = (k + 0.5f) / 64.0f, phi = 2.39996323f * k, s = std::sqrt(1 - z * z);
-        dirs.emplace_back(s * std::cos(phi), s * std::sin(phi), z);
-    }
-    std::vector<int> orders(n, bake.order);
-    tbb::parallel_for(0, n, [&](int i) {
-        std::vector<glm::vec3> full;
-        for (glm::vec3 w : dirs) full.push_back(glm::normalize(glm::vec3(decompressSample(bake, i, w))));
-        for (int l = 0; l < bake.order; ++l) {
-            double sum = 0;
-            for (size_t k = 0; k < dirs.size(); ++k) {
-                glm::vec3 e(decompressSample(bake, i, dirs[k], l));
-                float len = glm::length(e);
-                double c = len > 0 ? std::clamp(double(glm::dot(e / len, full[k])), -1.0, 1.0) : -1.0;
-                sum += std::acos(c) * 180.0 / M_PI;
-            }
-            if (sum / dirs.size() <= toleranceDeg) {
-                orders[i] = l;
-                break;
-            }
-        }
-    });
-    return orders;
-}
-
 namespace {
 
 // Closest point to p on triangle (a, b, c), as barycentric weights (u, v) of b and c.

@@ -32,11 +32,6 @@ nlohmann::json evaluateDirections(const BakeData& bake, const Scene& scene, size
                                   uint64_t seed, int order = -1, float zMin = 0.0f, float zMax = 1.0f,
                                   const std::vector<int>* sampleOrder = nullptr);
 
-// Per-sample adaptive order: for each sample the smallest order whose reconstruction differs
-// from the full-order one by at most `toleranceDeg` on average over 64 fixed directions of the
-// hemisphere (the SH themselves are the yardstick, so no tracing is needed).
-std::vector<int> adaptiveOrders(const BakeData& bake, double toleranceDeg);
-
 // Why queryBake refused a query: its index in p and w, and the problem.
 struct QueryRefused : InputError {
     QueryRefused(size_t i, const std::string& problem) : InputError(problem), index(i) {}

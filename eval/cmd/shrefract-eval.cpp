@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "eval/adaptive.h"
 #include "eval/directions.h"
 #include "eval/image_eval.h"
 #include "eval/reference.h"
@@ -112,6 +113,11 @@ int main(int argc, char** argv) {
     adaptive->add_option("--pairs", pairs, "pairs for the error")->capture_default_str();
     adaptive->add_option("--json", jsonPath, "write the report here");
     adaptive->add_option("--scene", scenePath, "the baked mesh or scene, if not where the manifest says");
+    std::string bakesPrefix;
+    adaptive->add_option("--write-bakes", bakesPrefix,
+                         "also write, per tolerance, what a per-sample order would draw: PREFIX_TOL.shrefract.exr "
+                         "(each sample fitted at its own order to fresh traces, its higher bands zero, "
+                         "its error model fitted anew; every band still stored)");
     auto* query = app.add_subcommand("query", "exit direction and length per (point, view direction)");
     query->add_option("bake", bakePath, "NAME.shrefract.exr")->required();
     query->add_option("--in", inPath, "CSV rows px,py,pz,wx,wy,wz (object space, w toward the viewer)")->required();
@@ -264,6 +270,14 @@ int main(int argc, char** argv) {
         const std::string stagedCsv = query->parsed() ? outputs.add(outPath) : "";
         const std::vector<double> tolerances =
             adaptive->parsed() ? parseTolerances(tolText) : std::vector<double>();
+        std::vector<std::string> bakePaths, stagedBakes;
+        if (!bakesPrefix.empty())
+            for (const double tol : tolerances) {
+                char name[64];
+                std::snprintf(name, sizeof name, "_%g.shrefract.exr", tol);
+                bakePaths.push_back(bakesPrefix + name);
+                stagedBakes.push_back(outputs.add(bakePaths.back()));
+            }
         ReadOptions readOptions;
         readOptions.verify = !noVerify;
         BakeData bake = readBake(bakePath, readOptions);
@@ -285,8 +299,10 @@ int main(int argc, char** argv) {
             std::printf("per-sample adaptive order (bake order %d): full-order error median %.2f, p95 %.1f deg\n",
                         bake.order, full["angleDeg"]["median"].get<double>(), full["angleDeg"]["p95"].get<double>());
             std::printf("  %9s  %12s  %14s  %10s  %8s\n", "tolerance", "mean order", "weights kept", "median", "p95");
+            std::vector<std::vector<int>> allOrders;
             for (const double tol : tolerances) {
                 std::vector<int> orders = adaptiveOrders(bake, tol);
+                allOrders.push_back(orders);
                 double kept = 0, meanOrder = 0;
                 for (int o : orders) kept += shEvenCount(o), meanOrder += o;
                 kept /= double(n) * shEvenCount(bake.order);
@@ -297,6 +313,20 @@ int main(int argc, char** argv) {
                 report["tolerances"].push_back({{"toleranceDeg", tol}, {"meanOrder", meanOrder},
                                                 {"weightsKept", kept}, {"median", r["angleDeg"]["median"]},
                                                 {"p95", r["angleDeg"]["p95"]}});
+            }
+            if (!bakePaths.empty()) {
+                std::printf("tracing every sample's grid again to fit %zu bakes at their per-sample orders\n",
+                            bakePaths.size());
+                std::vector<BakeData> perSample = perSampleOrderBakes(bake, scene, allOrders);
+                for (size_t t = 0; t < perSample.size(); ++t) {
+                    nlohmann::json& entry = report["tolerances"][t];
+                    perSample[t].manifest["perSampleOrder"] = {
+                        {"from", bakePath}, {"toleranceDeg", entry["toleranceDeg"]},
+                        {"meanOrder", entry["meanOrder"]}, {"weightsKept", entry["weightsKept"]}};
+                    writeBake(stagedBakes[t], perSample[t]);
+                    entry["bake"] = bakePaths[t];
+                    std::printf("  %g deg -> %s\n", tolerances[t], bakePaths[t].c_str());
+                }
             }
             if (!jsonPath.empty()) writeFile(stagedJson, report.dump(2) + "\n");
         } else if (dirs->parsed()) {

@@ -107,6 +107,29 @@ TEST(EvalCli, ChartBakeQueriesAreRefusedOffTheSurface) {
     EXPECT_TRUE(fs::exists(tmp("chart_on_a.csv")));
 }
 
+// adaptive --write-bakes: one readable bake per tolerance, its manifest naming the orders; at a
+// tolerance no reconstruction can exceed, every sample keeps band 0 alone. A prefix in a missing
+// folder is refused before any work.
+TEST(EvalCli, AdaptiveWritesThePerSampleOrderBakes) {
+    write(tmp("adaptive_tetra.off"), kTetraOff);
+    const std::string bake = tmp("adaptive_tetra.shrefract.exr"), prefix = tmp("adaptive_tetra_po");
+    fs::remove(bake);
+    CommandResult b = run(kBake + " " + tmp("adaptive_tetra.off") + " -o " + bake +
+                          " --rate 2 --grid 8x16 --order 4 --precision f32 --cache ''");
+    ASSERT_EQ(b.code, 0) << b.out;
+    fs::remove(prefix + "_180.shrefract.exr");
+    CommandResult a = run(kEval + " adaptive " + bake + " --tolerances 180 --pairs 200 --write-bakes " + prefix);
+    ASSERT_EQ(a.code, 0) << a.out;
+    const shrefract::BakeData d = shrefract::readBake(prefix + "_180.shrefract.exr");
+    EXPECT_EQ(d.manifest["perSampleOrder"]["meanOrder"].get<double>(), 0.0);
+    const size_t n = size_t(d.layout.sampleCount());
+    for (size_t k = n * 4; k < d.weights.size(); ++k) ASSERT_EQ(d.weights[k], 0.0f) << "weight " << k;
+    CommandResult missing = run(kEval + " adaptive " + bake + " --tolerances 180 --write-bakes " +
+                                tmp("no_such_folder/po"));
+    EXPECT_EQ(missing.code, 2) << missing.out;
+    EXPECT_NE(missing.out.find("no_such_folder"), std::string::npos) << missing.out;
+}
+
 // One exit-code table for every tool (README "Exit codes"): 0 for --help and --version (which names
 // the project and format versions), 2 for a usage error CLI11 reports (its own codes are 105-109)
 // and for bad input, with one "TOOL: error:" line.

@@ -7,6 +7,8 @@
 #include <memory>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "common/error.h"
 #include "common/sh.h"
 
@@ -61,6 +63,14 @@ std::string FitWeighting::ToString() const {
        << ":" << trimPasses;
     if (ridge > 0) os << ":" << ridge;
     return os.str();
+}
+
+RecordedFit recordedFit(const nlohmann::json& manifest) {
+    RecordedFit r;
+    r.fit = parseInput<Fit>(manifest.value("fit", "projection"));
+    if (r.fit == Fit::Weighted) r.weighting = FitWeighting::parse(manifest.value("fitWeighting", ""), "fitWeighting");
+    r.filterWidth = manifest.value("filterWidth", 0.0);
+    return r;
 }
 
 namespace {

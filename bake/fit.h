@@ -22,6 +22,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <nlohmann/json_fwd.hpp>
 
 #include "bake/tracer.h"
 #include "common/direction_grid.h"
@@ -65,6 +66,16 @@ struct FitWeighting {
     static FitWeighting parse(const std::string& text, const std::string& what = "--fit-weighting");
     std::string ToString() const;
 };
+
+// The fit a bake's manifest (or a shard's identity) records: "fit", the weighted fit's
+// "fitWeighting" and "filterWidth" (absent: the projection, unfiltered). Throws InputError on a
+// bad value.
+struct RecordedFit {
+    Fit fit = Fit::Projection;
+    FitWeighting weighting;
+    double filterWidth = 0.0;
+};
+RecordedFit recordedFit(const nlohmann::json& manifest);
 
 // Fits one sample at a time; build once per (grid, order, weighting), use from many threads.
 class WeightedFitter {

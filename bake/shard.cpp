@@ -76,9 +76,8 @@ BakeOptions optionsOf(const json& id) {
     const json grid = id.value("grid", json::array());
     if (!grid.is_array() || grid.size() != 2) throw InputError("no direction grid");
     o.grid = parseGrid(str(grid[0].get<int>(), "x", grid[1].get<int>()), "grid");
-    o.filterWidth = id.value("filterWidth", 0.0);
-    o.fit = parseInput<Fit>(id.value("fit", "projection"));
-    if (o.fit == Fit::Weighted) o.weighting = FitWeighting::parse(id.value("fitWeighting", ""), "fitWeighting");
+    const RecordedFit fit = recordedFit(id);
+    o.fit = fit.fit, o.weighting = fit.weighting, o.filterWidth = fit.filterWidth;
     o.trace.branch = id.value("branch", "") == "transmit" ? Branch::Transmit : Branch::Fresnel;
     o.trace.maxBounces = id.value("maxBounces", 32);
     o.coherent = id.value("tracer", "coherent") == "coherent";

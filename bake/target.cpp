@@ -238,11 +238,10 @@ TargetSearchResult searchTarget(const Scene& scene, const BakeOptions& base,
             tbb::parallel_for(size_t(0), ids.size(), [&](size_t s) {
                 enableFlushToZero();
                 const uint32_t i = ids[s];
-                const Frame f = Frame::fromNormal(L.normal[i]);
                 Eigen::MatrixXf R(J, 4), Wt;
                 std::vector<PathResult> paths(J);
+                traceSampleGrid(tracer, L, i, grid, false, paths.data());
                 for (int j = 0; j < J; ++j) {
-                    paths[j] = tracer.trace(L.position[i], L.normal[i], f.fromLocal(glm::vec3(grid.direction(j))), L.part[i]);
                     R.row(j) << paths[j].exit.x, paths[j].exit.y, paths[j].exit.z, paths[j].length;
                     if (gridBasis)
                         for (int c = 0; c < 4; ++c) traced[(size_t(j) * ids.size() + s) * 4 + c] = R(j, c);

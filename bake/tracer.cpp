@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "common/frame.h"
 #include "common/optics.h"
 
 namespace shrefract {
@@ -388,6 +389,24 @@ std::vector<uint32_t> packetOrder(int nTheta, int nPhi) {
             for (int i = ti; i < std::min(ti + 4, nTheta); ++i)
                 for (int k = tk; k < std::min(tk + 4, nPhi); ++k) order.push_back(uint32_t(i * nPhi + k));
     return order;
+}
+
+void traceSampleGrid(const Tracer& tracer, const SurfaceLayout& layout, size_t i,
+                     const DirectionGrid& grid, bool coherent, PathResult* paths) {
+    const Frame frame = Frame::fromNormal(layout.normal[i]);
+    const glm::vec3 p = layout.position[i], n = layout.normal[i];
+    const uint32_t part = layout.part[i];
+    const int J = grid.count();
+    if (!coherent) {
+        for (int j = 0; j < J; ++j) paths[j] = tracer.trace(p, n, frame.fromLocal(glm::vec3(grid.direction(j))), part);
+        return;
+    }
+    const std::vector<uint32_t> packet = packetOrder(grid.nTheta, grid.nPhi);
+    std::vector<glm::vec3> omegas(J);
+    std::vector<PathResult> traced(J);
+    for (int q = 0; q < J; ++q) omegas[q] = frame.fromLocal(glm::vec3(grid.direction(int(packet[q]))));
+    tracer.traceCoherent(p, n, omegas.data(), J, part, traced.data());
+    for (int q = 0; q < J; ++q) paths[packet[q]] = traced[q];
 }
 
 }  // namespace shrefract

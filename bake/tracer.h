@@ -7,6 +7,8 @@
 
 #include <glm/glm.hpp>
 
+#include "common/bakefile.h"
+#include "common/direction_grid.h"
 #include "common/scene.h"
 
 struct RTCRayHit;  // embree3/rtcore_ray.h
@@ -100,6 +102,12 @@ private:
 // The grid directions (index i * nPhi + k) in 4 x 4 tiles of (theta, phi): the order in which
 // traceCoherent's 16-ray packets are compact cones.
 std::vector<uint32_t> packetOrder(int nTheta, int nPhi);
+
+// The paths of sample i of `layout` at every direction of `grid` in the sample's frame, in grid
+// order (paths[j]: direction j's). Coherent: traceCoherent in packetOrder, as the bake traces a
+// sample; otherwise trace(), one path at a time.
+void traceSampleGrid(const Tracer& tracer, const SurfaceLayout& layout, size_t i,
+                     const DirectionGrid& grid, bool coherent, PathResult* paths);
 
 // Sets flush-to-zero and denormals-are-zero on the calling thread (every tracing thread).
 void enableFlushToZero();

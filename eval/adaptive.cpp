@@ -14,7 +14,6 @@
 #include "bake/tracer.h"
 #include "common/decompress.h"
 #include "common/error.h"
-#include "common/frame.h"
 #include "common/sh.h"
 #include "eval/reference.h"
 
@@ -58,16 +57,13 @@ std::vector<BakeData> perSampleOrderBakes(const BakeData& bake, const Scene& sce
     const DirectionGrid& grid = bake.grid;
     const int J = grid.count();
     // The bake's own fit, at every order some sample keeps.
-    const nlohmann::json& m = bake.manifest;
-    const Fit fit = parseInput<Fit>(m.value("fit", "projection"));
-    const FitWeighting weighting =
-        fit == Fit::Weighted ? FitWeighting::parse(m.value("fitWeighting", ""), "fitWeighting") : FitWeighting{};
+    const RecordedFit fit = recordedFit(bake.manifest);
     std::map<int, std::unique_ptr<SampleFit>> fits;
     for (const std::vector<int>& o : orders) {
         SHREFRACT_CHECK(o.size() == n);
         for (const int l : o)
             if (!fits.count(l))
-                fits[l] = std::make_unique<SampleFit>(grid, l, fit, weighting, m.value("filterWidth", 0.0), "");
+                fits[l] = std::make_unique<SampleFit>(grid, l, fit.fit, fit.weighting, fit.filterWidth, "");
     }
     std::unique_ptr<ResidualFitter> residual;
     if (bake.errorOrder >= 0) {
@@ -78,23 +74,13 @@ std::vector<BakeData> perSampleOrderBakes(const BakeData& bake, const Scene& sce
 
     std::vector<BakeData> out(orders.size(), bake);
     const Tracer tracer(scene, traceOptionsOfBake(bake));
-    std::vector<glm::vec3> local(J);
-    for (int j = 0; j < J; ++j) local[j] = glm::vec3(grid.direction(j));
-    const std::vector<uint32_t> packet = packetOrder(grid.nTheta, grid.nPhi);
     tbb::parallel_for(size_t(0), n, [&](size_t i) {
         enableFlushToZero();
         // The sample's paths at the grid directions, traced as the bake traced them.
-        const Frame frame = Frame::fromNormal(L.normal[i]);
-        std::vector<glm::vec3> omegas(J);
-        std::vector<PathResult> traced(J), paths(J);
-        for (int q = 0; q < J; ++q) omegas[q] = frame.fromLocal(local[packet[q]]);
-        tracer.traceCoherent(L.position[i], L.normal[i], omegas.data(), J, L.part[i], traced.data());
+        std::vector<PathResult> paths(J);
+        traceSampleGrid(tracer, L, i, grid, true, paths.data());
         Eigen::MatrixXf R(J, 4), C(0, 4), Wt = Eigen::MatrixXf::Zero(4, K), E(std::max(Ke, 1), 1);
-        for (int q = 0; q < J; ++q) {
-            const PathResult& p = traced[q];
-            paths[packet[q]] = p;
-            R.row(int(packet[q])) << p.exit.x, p.exit.y, p.exit.z, p.length;
-        }
+        for (int j = 0; j < J; ++j) R.row(j) << paths[j].exit.x, paths[j].exit.y, paths[j].exit.z, paths[j].length;
         for (size_t t = 0; t < out.size(); ++t) {
             // Fitted at its own order, every higher band zero; then the model of what it misses.
             const SampleFit& f = *fits.at(orders[t][i]);
